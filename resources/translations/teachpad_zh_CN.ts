@@ -962,108 +962,108 @@
     <context>
         <name>EnvelopeDialog</name>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="53" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="54" />
             <source>Safety envelope</source>
             <translation>安全范围</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="55" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="56" />
             <source>Check joint limits</source>
             <translation>检查关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="58" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="59" />
             <source>Min (°)</source>
             <translation>最小 (°)</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="58" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="59" />
             <source>Max (°)</source>
             <translation>最大 (°)</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="65" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="66" />
             <source>Keep the TCP inside this box</source>
             <translation>TCP 必须留在此长方体内</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="74" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="75" />
             <source>Name</source>
             <translation>名称</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="75" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="76" />
             <source>{axis} min</source>
             <translation>{axis} 最小</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="76" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="77" />
             <source>{axis} max</source>
             <translation>{axis} 最大</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="83" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="84" />
             <source>Add zone</source>
             <translation>添加禁区</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="85" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="86" />
             <source>Remove zone</source>
             <translation>删除禁区</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="95" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="96" />
             <source>Revision {n}</source>
             <translation>版本 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="99" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="100" />
             <source>Joint limits</source>
             <translation>关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="103" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="104" />
             <source>Work space (keep-in box)</source>
             <translation>工作空间（允许区域）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="112" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="113" />
             <source>Keep-out zones</source>
             <translation>禁入区域</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="120" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="121" />
             <source>Speeds</source>
             <translation>速度</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="122" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="123" />
             <source>Max jog speed:</source>
             <translation>最大点动速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="123" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="124" />
             <source>Max TCP speed (moves, plans):</source>
             <translation>最大 TCP 速度（移动、计划）：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="124" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="125" />
             <source>Reduced mode jog speed:</source>
             <translation>降速模式点动速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="125" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="126" />
             <source>Reduced mode TCP speed:</source>
             <translation>降速模式 TCP 速度：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="147" />
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="185" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="148" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="186" />
             <source>zone {n}</source>
             <translation>禁区 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/envelope_dialog.py" line="164" />
+            <location filename="../../ui/dialogs/envelope_dialog.py" line="165" />
             <source>{what}: '{text}' is not a number</source>
             <translation>{what}：“{text}”不是数字</translation>
         </message>
@@ -1071,37 +1071,37 @@
     <context>
         <name>EventLogModel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="123" />
+            <location filename="../../ui/panels/event_log.py" line="121" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="124" />
+            <location filename="../../ui/panels/event_log.py" line="122" />
             <source>Level</source>
             <translation>级别</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="125" />
+            <location filename="../../ui/panels/event_log.py" line="123" />
             <source>Source</source>
             <translation>来源</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="126" />
+            <location filename="../../ui/panels/event_log.py" line="124" />
             <source>Message</source>
             <translation>消息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="129" />
+            <location filename="../../ui/panels/event_log.py" line="127" />
             <source>Info</source>
             <translation>信息</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="130" />
+            <location filename="../../ui/panels/event_log.py" line="128" />
             <source>Warning</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="131" />
+            <location filename="../../ui/panels/event_log.py" line="129" />
             <source>Error</source>
             <translation>错误</translation>
         </message>
@@ -1109,82 +1109,82 @@
     <context>
         <name>EventLogPanel</name>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="324" />
+            <location filename="../../ui/panels/event_log.py" line="322" />
             <source>Show:</source>
             <translation>显示：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="325" />
+            <location filename="../../ui/panels/event_log.py" line="323" />
             <source>All events</source>
             <translation>全部事件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="326" />
+            <location filename="../../ui/panels/event_log.py" line="324" />
             <source>Warnings and errors</source>
             <translation>警告和错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="327" />
+            <location filename="../../ui/panels/event_log.py" line="325" />
             <source>Errors only</source>
             <translation>仅错误</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="328" />
+            <location filename="../../ui/panels/event_log.py" line="326" />
             <source>Clear</source>
             <translation>清空</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="329" />
+            <location filename="../../ui/panels/event_log.py" line="327" />
             <source>Export…</source>
             <translation>导出…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="372" />
+            <location filename="../../ui/panels/event_log.py" line="370" />
             <source>event log</source>
             <translation>事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="373" />
+            <location filename="../../ui/panels/event_log.py" line="371" />
             <source>The event log is not saved for the next start: {why}</source>
             <translation>事件日志无法保存到下次启动：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="423" />
+            <location filename="../../ui/panels/event_log.py" line="421" />
             <source>alarm</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="420" />
+            <location filename="../../ui/panels/event_log.py" line="418" />
             <source>Alarm raised: {name}</source>
             <translation>报警触发：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="420" />
+            <location filename="../../ui/panels/event_log.py" line="418" />
             <source>Alarm cleared: {name}</source>
             <translation>报警解除：{name}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="429" />
+            <location filename="../../ui/panels/event_log.py" line="427" />
             <source>bit {n}</source>
             <translation>第 {n} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="433" />
+            <location filename="../../ui/panels/event_log.py" line="431" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="465" />
+            <location filename="../../ui/panels/event_log.py" line="463" />
             <source>link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="490" />
+            <location filename="../../ui/panels/event_log.py" line="488" />
             <source>Export event log</source>
             <translation>导出事件日志</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/event_log.py" line="492" />
+            <location filename="../../ui/panels/event_log.py" line="490" />
             <source>Text files (*.txt *.log);;All files (*)</source>
             <translation>文本文件 (*.txt *.log);;所有文件 (*)</translation>
         </message>
@@ -1192,7 +1192,7 @@
     <context>
         <name>Export</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="409" />
+            <location filename="../../ui/widgets_common.py" line="382" />
             <source>Could not write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
@@ -1492,7 +1492,7 @@
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="332" />
+            <location filename="../../ui/main_window.py" line="352" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
@@ -1523,7 +1523,7 @@
             <translation>往返 —</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="378" />
+            <location filename="../../ui/main_window.py" line="398" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
@@ -1548,30 +1548,30 @@
             <translation>此控制器上还有另一个 Modbus 主站：{sign}。它与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。请检查还有谁连接着控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="401" />
+            <location filename="../../ui/main_window.py" line="421" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="356" />
-            <location filename="../../ui/main_window.py" line="380" />
-            <location filename="../../ui/main_window.py" line="389" />
-            <location filename="../../ui/main_window.py" line="402" />
+            <location filename="../../ui/main_window.py" line="376" />
+            <location filename="../../ui/main_window.py" line="400" />
+            <location filename="../../ui/main_window.py" line="409" />
+            <location filename="../../ui/main_window.py" line="422" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="309" />
+            <location filename="../../ui/main_window.py" line="329" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="310" />
+            <location filename="../../ui/main_window.py" line="330" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="311" />
+            <location filename="../../ui/main_window.py" line="331" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1581,37 +1581,37 @@
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="396" />
+            <location filename="../../ui/main_window.py" line="416" />
             <source>plan run</source>
             <translation>计划运行</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="476" />
+            <location filename="../../ui/main_window.py" line="496" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="478" />
+            <location filename="../../ui/main_window.py" line="498" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="491" />
+            <location filename="../../ui/main_window.py" line="511" />
             <source>Safety state (roles, envelope, audit trail), machine-wide: {folder}</source>
             <translation>安全状态（角色、安全范围、审计记录），本机共用：{folder}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="493" />
+            <location filename="../../ui/main_window.py" line="513" />
             <source>Safety state (roles, envelope), this user's: {folder}&lt;br&gt;Audit trail: {audit}</source>
             <translation>安全状态（角色、安全范围），当前用户：{folder}&lt;br&gt;审计记录：{audit}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="512" />
+            <location filename="../../ui/main_window.py" line="532" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="512" />
+            <location filename="../../ui/main_window.py" line="532" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -1619,368 +1619,368 @@
     <context>
         <name>Messages</name>
         <message>
-            <location filename="../../ui/messages.py" line="68" />
+            <location filename="../../ui/messages.py" line="67" />
             <source>{command}: {status}.</source>
             <translation>{command}：{status}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="69" />
+            <location filename="../../ui/messages.py" line="68" />
             <source>{command}: done, not confirmed by the controller.</source>
             <translation>{command}：已完成，控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="70" />
+            <location filename="../../ui/messages.py" line="69" />
             <source>{command}: done (the controller is now in {mode} mode).</source>
             <translation>{command}：已完成（控制器现处于{mode}模式）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="71" />
+            <location filename="../../ui/messages.py" line="70" />
             <source>{command} refused by the controller: {status}.</source>
             <translation>控制器拒绝了{command}：{status}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="72" />
+            <location filename="../../ui/messages.py" line="71" />
             <source>{command} not taken: the controller still shows “{status}” from the previous command.</source>
             <translation>{command}未被执行：控制器仍显示上一条命令的“{status}”。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="76" />
+            <location filename="../../ui/messages.py" line="75" />
             <source>{command} ended by an alarm: {alarms}.</source>
             <translation>{command}因报警而中止：{alarms}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="77" />
+            <location filename="../../ui/messages.py" line="76" />
             <source>{command}: the controller did not acknowledge it within {seconds} s.</source>
             <translation>{command}：控制器在 {seconds} s 内未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="80" />
+            <location filename="../../ui/messages.py" line="79" />
             <source>{command} did not finish within {seconds} s (last status: {status}).</source>
             <translation>{command}未在 {seconds} s 内完成（最后状态：{status}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="83" />
+            <location filename="../../ui/messages.py" line="82" />
             <source>{command}: the arm moved and stopped, but the controller did not report the result.</source>
             <translation>{command}：机械臂已运动并停止，但控制器未报告结果。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="86" />
+            <location filename="../../ui/messages.py" line="85" />
             <source>{command}: stopped by the operator.</source>
             <translation>{command}：已由操作员停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="87" />
+            <location filename="../../ui/messages.py" line="86" />
             <source>{command}: stopped by the controller.</source>
             <translation>{command}：已被控制器停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="88" />
+            <location filename="../../ui/messages.py" line="87" />
             <source>{command}: sent (not waited for).</source>
             <translation>{command}：已发送（未等待结果）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="89" />
+            <location filename="../../ui/messages.py" line="88" />
             <source>{command}: no motion within {seconds} s (refused by the controller, or already there).</source>
             <translation>{command}：{seconds} s 内没有运动（被控制器拒绝，或已在目标位置）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="93" />
+            <location filename="../../ui/messages.py" line="92" />
             <source>{command} refused by the controller: {alarms}.</source>
             <translation>{command}被控制器拒绝：{alarms}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="94" />
+            <location filename="../../ui/messages.py" line="93" />
             <source>{command}: sent; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{command}：已发送，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="97" />
+            <location filename="../../ui/messages.py" line="96" />
             <source>{command}: done (the axes were already at zero).</source>
             <translation>{command}：完成（各轴已在零位）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="98" />
+            <location filename="../../ui/messages.py" line="97" />
             <source>{command}: the arm stopped before zero ({axis} at {value}).</source>
             <translation>{command}：机械臂在到达零位前停止（{axis} 位于 {value}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="101" />
+            <location filename="../../ui/messages.py" line="100" />
             <source>{command} not sent: another Modbus master wrote to the controller less than {seconds} s ago and its writes could change this move. Make sure no other master is commanding the robot, then send it again.</source>
             <translation>{command}未发送：另一个 Modbus 主站在不到 {seconds} 秒前写入了控制器，它的写入可能改变这次运动。请确认没有其他主站在指挥机器人，然后再发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="106" />
+            <location filename="../../ui/messages.py" line="105" />
             <source>{command} not sent: a program or motion is under way on the controller; wait for it to end, or press Stop.</source>
             <translation>{command}未发送：控制器上有程序或运动正在进行；请等待其结束，或按停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="110" />
+            <location filename="../../ui/messages.py" line="109" />
             <source>{command}: the controller did not show it within {seconds} s.</source>
             <translation>{command}：控制器在 {seconds} s 内未显示该状态。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="113" />
+            <location filename="../../ui/messages.py" line="112" />
             <source>Program {program} did not start: no such program, or the controller refused it.</source>
             <translation>程序 {program} 未启动：没有该程序，或控制器拒绝执行。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="116" />
+            <location filename="../../ui/messages.py" line="115" />
             <source>Uploaded {uploaded} of {total} points.</source>
             <translation>已上传 {uploaded}/{total} 个点。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="118" />
+            <location filename="../../ui/messages.py" line="117" />
             <source>{operation}: sent.</source>
             <translation>{operation}：已发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="119" />
+            <location filename="../../ui/messages.py" line="118" />
             <source>{operation}: failed.</source>
             <translation>{operation}：失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="120" />
+            <location filename="../../ui/messages.py" line="119" />
             <source>{operation} is still under way: wait for it or press Stop.</source>
             <translation>{operation}仍在进行：请等待其结束或按停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="121" />
+            <location filename="../../ui/messages.py" line="120" />
             <source>{operation} is still under way: wait for it, cancel it or press Stop.</source>
             <translation>{operation}仍在进行：请等待其结束、取消它或按停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="124" />
+            <location filename="../../ui/messages.py" line="123" />
             <source>The link is shut down: nothing was sent.</source>
             <translation>通信链路已关闭：未发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="125" />
+            <location filename="../../ui/messages.py" line="124" />
             <source>Not connected to a controller: nothing was sent.</source>
             <translation>未连接控制器：未发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="127" />
+            <location filename="../../ui/messages.py" line="126" />
             <source>Jog stopped: the controller is not answering (speed 0 is sent as soon as it answers).</source>
             <translation>点动已停止：控制器无应答（一旦应答即发送速度 0）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="130" />
+            <location filename="../../ui/messages.py" line="129" />
             <source>Jog stopped: the controller left teach mode (now in {mode} mode).</source>
             <translation>点动已停止：控制器已退出示教模式（当前为{mode}模式）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="133" />
+            <location filename="../../ui/messages.py" line="132" />
             <source>The controller is not answering: the jog was not started.</source>
             <translation>控制器无应答：点动未启动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="137" />
+            <location filename="../../ui/messages.py" line="136" />
             <source>Releasing — the controller has not confirmed: it refused or did not answer speed 0. Speed 0 is sent again at every poll until the controller answers and the arm stands still.</source>
             <translation>正在松开 — 控制器尚未确认：它拒绝或未应答速度 0。每次轮询都会重新发送速度 0，直到控制器应答且机械臂静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="142" />
+            <location filename="../../ui/messages.py" line="141" />
             <source>Releasing — the controller has not confirmed speed 0 after {seconds} s: Stop is sent as well, at every poll, until the controller takes it.</source>
             <translation>正在松开 — {seconds} 秒后控制器仍未确认速度 0：每次轮询同时发送停止命令，直到控制器接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="147" />
+            <location filename="../../ui/messages.py" line="146" />
             <source>Jog stopped: the controller confirmed after {seconds} s and the arm stands still.</source>
             <translation>点动已停止：控制器在 {seconds} 秒后确认，机械臂已静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="150" />
+            <location filename="../../ui/messages.py" line="149" />
             <source>Stopping — the controller has not confirmed: it refused or did not answer the Stop. Stop is sent again at every poll until the controller takes it and the arm stands still.</source>
             <translation>正在停止 — 控制器尚未确认：它拒绝或未应答停止命令。每次轮询都会重新发送停止命令，直到控制器接受且机械臂静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="155" />
+            <location filename="../../ui/messages.py" line="154" />
             <source>Stop confirmed by the controller after {seconds} s; the arm stands still.</source>
             <translation>控制器在 {seconds} 秒后确认停止；机械臂已静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="158" />
+            <location filename="../../ui/messages.py" line="157" />
             <source>{operation} refused: the controller has not confirmed that the arm stopped (the stop is sent again at every poll). Press Stop, or wait until the arm stands still.</source>
             <translation>{operation}被拒绝：控制器尚未确认机械臂已停止（每次轮询都会重新发送停止）。请按停止，或等待机械臂静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="163" />
+            <location filename="../../ui/messages.py" line="162" />
             <source>The controller is not answering: the plan was not started. Try again when it answers.</source>
             <translation>控制器无应答：计划未启动。待其恢复应答后再试。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="166" />
+            <location filename="../../ui/messages.py" line="165" />
             <source>Jog speed {value}% is not within 1..100%.</source>
             <translation>点动速度 {value}% 不在 1..100% 范围内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="168" />
+            <location filename="../../ui/messages.py" line="167" />
             <source>Lost the connection to the controller at {endpoint}.</source>
             <translation>与控制器 {endpoint} 的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="169" />
+            <location filename="../../ui/messages.py" line="168" />
             <source>The controller at {endpoint} closed the connection.</source>
             <translation>控制器 {endpoint} 关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="170" />
+            <location filename="../../ui/messages.py" line="169" />
             <source>The host name {host} cannot be resolved.</source>
             <translation>无法解析主机名 {host}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="171" />
+            <location filename="../../ui/messages.py" line="170" />
             <source>The host name {host} is not valid: check it in Connect…</source>
             <translation>主机名 {host} 无效：请在“连接…”中检查。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="172" />
+            <location filename="../../ui/messages.py" line="171" />
             <source>Connection refused: nothing listens on port {port}.</source>
             <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="175" />
+            <location filename="../../ui/messages.py" line="174" />
             <source>No answer to the connection request within {seconds} s.</source>
             <translation>连接请求在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="178" />
+            <location filename="../../ui/messages.py" line="177" />
             <source>The connection could not be opened.</source>
             <translation>无法建立连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="179" />
+            <location filename="../../ui/messages.py" line="178" />
             <source>Cannot open the serial port {port}.</source>
             <translation>无法打开串口 {port}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="180" />
+            <location filename="../../ui/messages.py" line="179" />
             <source>The controller at {endpoint} did not answer within {seconds} s.</source>
             <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="183" />
+            <location filename="../../ui/messages.py" line="182" />
             <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
             <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="187" />
+            <location filename="../../ui/messages.py" line="186" />
             <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
             <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="191" />
+            <location filename="../../ui/messages.py" line="190" />
             <source>No device answered at unit id {unit} (Modbus exception {exception}, {name}): check the unit id in Connect…</source>
             <translation>从站地址 {unit} 上没有设备应答（Modbus 异常 {exception}，{name}）：请在“连接…”中检查从站地址。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="195" />
+            <location filename="../../ui/messages.py" line="194" />
             <source>Monitor-only mode: nothing was sent to the controller.</source>
             <translation>仅监视模式：未向控制器发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="196" />
+            <location filename="../../ui/messages.py" line="195" />
             <source>Not sent: the audit trail in {folder} cannot be written ({cause}). No write goes out without its record (Stop still does): free disk space or fix the audit folder.</source>
             <translation>未发送：审计记录目录 {folder} 无法写入（{cause}）。没有审计记录的写入一律不发送（停止除外）：请释放磁盘空间或修复审计目录。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="201" />
+            <location filename="../../ui/messages.py" line="200" />
             <source>{operation}: not sent, the controller is in {mode} mode. Switching it to auto is the operator's decision: say yes when the confirmation asks, or switch it to auto first.</source>
             <translation>{operation}：未发送，控制器处于{mode}模式。切换到自动模式须由操作员决定：在确认框询问时选择“是”，或先将其切换到自动模式。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="206" />
+            <location filename="../../ui/messages.py" line="205" />
             <source>{operation}: not sent in reduced-speed mode: it runs at the controller's own speed, which TeachPad cannot cap.</source>
             <translation>{operation}：降速模式下未发送：它以控制器自身的速度运行，TeachPad 无法限制该速度。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="211" />
-            <location filename="../../ui/messages_plan.py" line="30" />
+            <location filename="../../ui/messages.py" line="210" />
+            <location filename="../../ui/messages_plan.py" line="29" />
             <source>Invalid value: nothing was sent.</source>
             <translation>数值无效：未发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="212" />
+            <location filename="../../ui/messages.py" line="211" />
             <source>Unexpected internal error; the log has the details.</source>
             <translation>意外的内部错误；详情见日志。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="214" />
+            <location filename="../../ui/messages.py" line="213" />
             <source>The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming.</source>
             <translation>机械臂停在 ({got})，距 {point} ({want}) {distance} mm：控制器中的该点与本项目不一致（被其他工具改写？）。恢复运行前请检查该点和机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="218" />
+            <location filename="../../ui/messages.py" line="217" />
             <source>The controller did not create {point} again before the move: the arm was not moved.</source>
             <translation>运动前控制器未能重新创建 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="221" />
+            <location filename="../../ui/messages.py" line="220" />
             <source>The project has no point {point}: the arm was not moved.</source>
             <translation>项目中没有点 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="224" />
+            <location filename="../../ui/messages.py" line="223" />
             <source>The arm's position after the move to {point} is not known: the run is stopped.</source>
             <translation>移动到 {point} 后机械臂的位置未知：运行已停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="228" />
+            <location filename="../../ui/messages.py" line="227" />
             <source>The link was shut down.</source>
             <translation>通信链路已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="238" />
+            <location filename="../../ui/messages.py" line="237" />
             <source>{operation}: not sent, the connection to the controller is down.</source>
             <translation>{operation}：未发送，与控制器的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="241" />
+            <location filename="../../ui/messages.py" line="240" />
             <source>{operation}: not sent, the connection was closed.</source>
             <translation>{operation}：未发送，连接已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="243" />
+            <location filename="../../ui/messages.py" line="242" />
             <source>points outside {id_min}..{id_max}: {ids}</source>
             <translation>超出 {id_min}..{id_max} 范围的点：{ids}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="244" />
+            <location filename="../../ui/messages.py" line="243" />
             <source>there is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="245" />
+            <location filename="../../ui/messages.py" line="244" />
             <source>no free point id left in {start}..{id_max}</source>
             <translation>{start}..{id_max} 范围内已没有空闲的点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="246" />
+            <location filename="../../ui/messages.py" line="245" />
             <source>there is no row {row}</source>
             <translation>不存在第 {row} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="247" />
+            <location filename="../../ui/messages.py" line="246" />
             <source>cannot move row {src} to {dst} in {rows} rows</source>
             <translation>无法在 {rows} 行中将第 {src} 行移到第 {dst} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="248" />
+            <location filename="../../ui/messages.py" line="247" />
             <source>row {row}: id {id} is already used on row {other}</source>
             <translation>第 {row} 行：编号 {id} 已被第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="249" />
+            <location filename="../../ui/messages.py" line="248" />
             <source>imported point {number}: id {id} appears twice</source>
             <translation>导入的第 {number} 个点：编号 {id} 出现了两次</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="250" />
+            <location filename="../../ui/messages.py" line="249" />
             <source>id {id} is already used by {point}</source>
             <translation>编号 {id} 已被 {point} 使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="251" />
+            <location filename="../../ui/messages.py" line="250" />
             <source>the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)</source>
             <translation>文件中没有点：用它替换将删除工程中全部 {existing} 个点（请改用合并，或明确要求空导入）</translation>
         </message>
@@ -2080,562 +2080,562 @@
             <translation>编号 {id} 已在第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="229" />
+            <location filename="../../ui/messages.py" line="228" />
             <source>{operation}: the connection was lost while it was under way; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{operation}：执行期间连接中断，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="233" />
+            <location filename="../../ui/messages.py" line="232" />
             <source>{operation}: the connection was closed while it was under way; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{operation}：执行期间连接被关闭，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="261" />
+            <location filename="../../ui/messages.py" line="260" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="262" />
+            <location filename="../../ui/messages.py" line="261" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="263" />
+            <location filename="../../ui/messages.py" line="262" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="264" />
+            <location filename="../../ui/messages.py" line="263" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="265" />
+            <location filename="../../ui/messages.py" line="264" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="266" />
+            <location filename="../../ui/messages.py" line="265" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="267" />
+            <location filename="../../ui/messages.py" line="266" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="268" />
+            <location filename="../../ui/messages.py" line="267" />
             <source>The host name is not valid.</source>
             <translation>主机名无效。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="269" />
+            <location filename="../../ui/messages.py" line="268" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="270" />
+            <location filename="../../ui/messages.py" line="269" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="271" />
+            <location filename="../../ui/messages.py" line="270" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="272" />
+            <location filename="../../ui/messages.py" line="271" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="273" />
+            <location filename="../../ui/messages.py" line="272" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="274" />
+            <location filename="../../ui/messages.py" line="273" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="275" />
+            <location filename="../../ui/messages.py" line="274" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="278" />
+            <location filename="../../ui/messages.py" line="277" />
             <source>{operation}: not sent, the controller is not in auto mode.</source>
             <translation>{operation}：未发送，控制器不处于自动模式。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="283" />
+            <location filename="../../ui/messages.py" line="282" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="284" />
+            <location filename="../../ui/messages.py" line="283" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="285" />
+            <location filename="../../ui/messages.py" line="284" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="286" />
+            <location filename="../../ui/messages.py" line="285" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="287" />
+            <location filename="../../ui/messages.py" line="286" />
             <source>Failed: {message}</source>
             <translation>失败：{message}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="290" />
+            <location filename="../../ui/messages.py" line="289" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="291" />
+            <location filename="../../ui/messages.py" line="290" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="292" />
+            <location filename="../../ui/messages.py" line="291" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="293" />
+            <location filename="../../ui/messages.py" line="292" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="294" />
+            <location filename="../../ui/messages.py" line="293" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="295" />
+            <location filename="../../ui/messages.py" line="294" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="296" />
+            <location filename="../../ui/messages.py" line="295" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="297" />
+            <location filename="../../ui/messages.py" line="296" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="298" />
+            <location filename="../../ui/messages.py" line="297" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="299" />
+            <location filename="../../ui/messages.py" line="298" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="300" />
+            <location filename="../../ui/messages.py" line="299" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="301" />
+            <location filename="../../ui/messages.py" line="300" />
             <source>move to temp point</source>
             <translation>运动至临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="302" />
+            <location filename="../../ui/messages.py" line="301" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="303" />
+            <location filename="../../ui/messages.py" line="302" />
             <source>cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="304" />
+            <location filename="../../ui/messages.py" line="303" />
             <source>teach disable</source>
             <translation>示教禁止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="305" />
+            <location filename="../../ui/messages.py" line="304" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="306" />
+            <location filename="../../ui/messages.py" line="305" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="307" />
+            <location filename="../../ui/messages.py" line="306" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="308" />
+            <location filename="../../ui/messages.py" line="307" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="309" />
+            <location filename="../../ui/messages.py" line="308" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="311" />
+            <location filename="../../ui/messages.py" line="310" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="314" />
+            <location filename="../../ui/messages.py" line="313" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="315" />
+            <location filename="../../ui/messages.py" line="314" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="316" />
+            <location filename="../../ui/messages.py" line="315" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="317" />
+            <location filename="../../ui/messages.py" line="316" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="318" />
+            <location filename="../../ui/messages.py" line="317" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="319" />
+            <location filename="../../ui/messages.py" line="318" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="320" />
+            <location filename="../../ui/messages.py" line="319" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="321" />
+            <location filename="../../ui/messages.py" line="320" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="322" />
+            <location filename="../../ui/messages.py" line="321" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="323" />
+            <location filename="../../ui/messages.py" line="322" />
             <source>unit id</source>
             <translation>从站地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="324" />
+            <location filename="../../ui/messages.py" line="323" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="328" />
+            <location filename="../../ui/messages.py" line="327" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="329" />
+            <location filename="../../ui/messages.py" line="328" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="330" />
+            <location filename="../../ui/messages.py" line="329" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="331" />
+            <location filename="../../ui/messages.py" line="330" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="332" />
+            <location filename="../../ui/messages.py" line="331" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="333" />
+            <location filename="../../ui/messages.py" line="332" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="334" />
+            <location filename="../../ui/messages.py" line="333" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="335" />
+            <location filename="../../ui/messages.py" line="334" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="336" />
+            <location filename="../../ui/messages.py" line="335" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="337" />
+            <location filename="../../ui/messages.py" line="336" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="339" />
+            <location filename="../../ui/messages.py" line="338" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="532" />
+            <location filename="../../ui/messages.py" line="531" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="535" />
+            <location filename="../../ui/messages.py" line="534" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="581" />
+            <location filename="../../ui/messages.py" line="580" />
             <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
             <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="584" />
+            <location filename="../../ui/messages.py" line="583" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="588" />
+            <location filename="../../ui/messages.py" line="587" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="591" />
+            <location filename="../../ui/messages.py" line="590" />
             <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="594" />
+            <location filename="../../ui/messages.py" line="593" />
             <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="624" />
+            <location filename="../../ui/messages.py" line="623" />
             <source>{operation}: not sent, cancelled by Stop.</source>
             <translation>{operation}：未发送，已被停止取消。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="625" />
+            <location filename="../../ui/messages.py" line="624" />
             <source>{operation}: not sent, the upload was cancelled.</source>
             <translation>{operation}：未发送，上传已取消。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="34" />
+            <location filename="../../ui/messages_plan.py" line="33" />
             <source>{where}{axis} = {value} {unit} is outside the allowed work space (limit {limit} {unit}).</source>
             <translation>{where}{axis} = {value} {unit} 超出允许的工作空间（限值 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="37" />
+            <location filename="../../ui/messages_plan.py" line="36" />
             <source>{where}the path enters the keep-out zone “{box}” ({axis} = {value} {unit}, its face is at {limit} {unit}).</source>
             <translation>{where}路径进入禁入区“{box}”（{axis} = {value} {unit}，边界位于 {limit} {unit}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="41" />
+            <location filename="../../ui/messages_plan.py" line="40" />
             <source>{where}{axis} = {value}° is past its limit {limit}°.</source>
             <translation>{where}{axis} = {value}° 超过其限位 {limit}°。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="42" />
+            <location filename="../../ui/messages_plan.py" line="41" />
             <source>{where}speed {value} mm/s is above the {limit} mm/s allowed.</source>
             <translation>{where}速度 {value} mm/s 超过允许的 {limit} mm/s。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="43" />
+            <location filename="../../ui/messages_plan.py" line="42" />
             <source>{where}jog speed {value}% is above the {limit}% allowed.</source>
             <translation>{where}点动速度 {value}% 超过允许的 {limit}%。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="44" />
+            <location filename="../../ui/messages_plan.py" line="43" />
             <source>{where}{axis} = {value} {unit} is within stopping distance of its limit {limit} {unit}.</source>
             <translation>{where}{axis} = {value} {unit} 已进入限值 {limit} {unit} 的停止距离内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="48" />
+            <location filename="../../ui/messages_plan.py" line="47" />
             <source>Refused by the safety envelope: {text}</source>
             <translation>安全边界拒绝：{text}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="49" />
+            <location filename="../../ui/messages_plan.py" line="48" />
             <source>segment {n}: </source>
             <translation>第 {n} 段：</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="50" />
+            <location filename="../../ui/messages_plan.py" line="49" />
             <source> (reduced-speed mode)</source>
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="541" />
+            <location filename="../../ui/messages.py" line="540" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="545" />
+            <location filename="../../ui/messages.py" line="544" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="86" />
+            <location filename="../../ui/messages_plan.py" line="85" />
             <source>Plan “{plan}” has no segments.</source>
             <translation>规划“{plan}”没有任何段。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="87" />
+            <location filename="../../ui/messages_plan.py" line="86" />
             <source>Cannot start at segment {start}: the plan has {segments} segments.</source>
             <translation>无法从第 {start} 段开始：该规划只有 {segments} 段。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="90" />
+            <location filename="../../ui/messages_plan.py" line="89" />
             <source>speed {speed} mm/s is not in (0, {max}] mm/s.</source>
             <translation>速度 {speed} mm/s 不在 (0, {max}] mm/s 范围内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="91" />
+            <location filename="../../ui/messages_plan.py" line="90" />
             <source>the arc has no middle point.</source>
             <translation>圆弧没有中间点。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="92" />
+            <location filename="../../ui/messages_plan.py" line="91" />
             <source>middle point P{id} does not exist.</source>
             <translation>中间点 P{id} 不存在。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="93" />
+            <location filename="../../ui/messages_plan.py" line="92" />
             <source>end point P{id} does not exist.</source>
             <translation>终点 P{id} 不存在。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="94" />
+            <location filename="../../ui/messages_plan.py" line="93" />
             <source>{point} is not on the controller ({sync}); upload it.</source>
             <translation>{point} 不在控制器上（{sync}）；请上传。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="95" />
+            <location filename="../../ui/messages_plan.py" line="94" />
             <source>{point} was taught with {point_tool}, the segment moves with {segment_tool}.</source>
             <translation>{point} 示教时的工具为“{point_tool}”，该段运动的工具为“{segment_tool}”。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="98" />
+            <location filename="../../ui/messages_plan.py" line="97" />
             <source>the line goes nowhere (start and end {length} mm apart){where}.</source>
             <translation>直线没有移动（起点与终点相距 {length} mm）{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="101" />
+            <location filename="../../ui/messages_plan.py" line="100" />
             <source>the arc starts at the robot's current pose, which is not known: its shape is not checked.</source>
             <translation>圆弧从机器人的当前位姿开始，但当前位姿未知：未检查其形状。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="105" />
+            <location filename="../../ui/messages_plan.py" line="104" />
             <source>the arc's start and middle points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的起点与中间点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="109" />
+            <location filename="../../ui/messages_plan.py" line="108" />
             <source>the arc's middle and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的中间点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="113" />
+            <location filename="../../ui/messages_plan.py" line="112" />
             <source>the arc's start and end points coincide (closer than {tolerance} mm): three distinct points are needed{where}.</source>
             <translation>圆弧的起点与终点重合（距离小于 {tolerance} mm）：需要三个不同的点{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="117" />
+            <location filename="../../ui/messages_plan.py" line="116" />
             <source>the arc's three points are (nearly) on one line: the middle point is {offset} mm off the start-end line (at least {tolerance} mm needed); use a line instead{where}.</source>
             <translation>圆弧的三个点（几乎）在一条直线上：中间点距起点—终点连线仅 {offset} mm（至少需要 {tolerance} mm）；请改用直线{where}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="121" />
+            <location filename="../../ui/messages_plan.py" line="120" />
             <source>the arm stopped past the arc's middle point: sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); move to the end point with a line, or run from the segment before.</source>
             <translation>机械臂停在圆弧中间点之后：从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；请用直线移动到终点，或从前一段开始运行。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="125" />
+            <location filename="../../ui/messages_plan.py" line="124" />
             <source>sent from here the arc would swing {sweep}° round through the middle point (planned {planned}°); check the preview before running from here.</source>
             <translation>从此处发送，圆弧将经过中间点绕行 {sweep}°（计划 {planned}°）；从此处运行前请检查预览。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="129" />
+            <location filename="../../ui/messages_plan.py" line="128" />
             <source>{point} is out of the robot model's reach.</source>
             <translation>{point} 超出机器人模型的可达范围。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="130" />
+            <location filename="../../ui/messages_plan.py" line="129" />
             <source>the path is out of the robot model's reach.</source>
             <translation>路径超出机器人模型的可达范围。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="131" />
+            <location filename="../../ui/messages_plan.py" line="130" />
             <source>{point} passes a joint limit of the robot model.</source>
             <translation>{point} 会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="132" />
+            <location filename="../../ui/messages_plan.py" line="131" />
             <source>the path passes a joint limit of the robot model.</source>
             <translation>路径会超过机器人模型的关节限位。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="133" />
+            <location filename="../../ui/messages_plan.py" line="132" />
             <source>The robot model “{model}” disagrees with the controller's pose by {distance} mm: reach checks may be wrong.</source>
             <translation>机器人模型“{model}”与控制器的位姿相差 {distance} mm：可达性检查可能有误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="137" />
+            <location filename="../../ui/messages_plan.py" line="136" />
             <source>The robot model “{model}” disagrees with the controller's pose by {angle}°: reach checks may be wrong.</source>
             <translation>机器人模型“{model}”与控制器的位姿相差 {angle}°：可达性检查可能有误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="141" />
+            <location filename="../../ui/messages_plan.py" line="140" />
             <source>The robot model “{model}” disagrees with the controller's pose by {distance} mm and {angle}°: reach checks may be wrong.</source>
             <translation>机器人模型“{model}”与控制器的位姿相差 {distance} mm 和 {angle}°：可达性检查可能有误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="145" />
+            <location filename="../../ui/messages_plan.py" line="144" />
             <source>runs at {cap} mm/s, the reduced-speed cap (planned {speed} mm/s).</source>
             <translation>以降速模式上限 {cap} mm/s 运行（计划 {speed} mm/s）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="149" />
+            <location filename="../../ui/messages_plan.py" line="148" />
             <source> (from the current pose)</source>
             <translation>（从当前位姿出发）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="150" />
+            <location filename="../../ui/messages_plan.py" line="149" />
             <source> (on loops after the first, starting at the end of segment {after})</source>
             <translation>（第一轮之后的循环中，从第 {after} 段的终点出发）</translation>
         </message>
@@ -2904,105 +2904,105 @@
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="194" />
-            <location filename="../../ui/panels/monitor_panel.py" line="213" />
+            <location filename="../../ui/panels/monitor_panel.py" line="191" />
+            <location filename="../../ui/panels/monitor_panel.py" line="210" />
             <source>mm</source>
             <extracomment>Attributes that exist once the plots are built (asking for one builds them).</extracomment>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="194" />
-            <location filename="../../ui/panels/monitor_panel.py" line="213" />
+            <location filename="../../ui/panels/monitor_panel.py" line="191" />
+            <location filename="../../ui/panels/monitor_panel.py" line="210" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="195" />
+            <location filename="../../ui/panels/monitor_panel.py" line="192" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="197" />
+            <location filename="../../ui/panels/monitor_panel.py" line="194" />
             <source>Joints and external axes (°)</source>
             <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="201" />
+            <location filename="../../ui/panels/monitor_panel.py" line="198" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="202" />
+            <location filename="../../ui/panels/monitor_panel.py" line="199" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="203" />
+            <location filename="../../ui/panels/monitor_panel.py" line="200" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="204" />
+            <location filename="../../ui/panels/monitor_panel.py" line="201" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="205" />
+            <location filename="../../ui/panels/monitor_panel.py" line="202" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="206" />
+            <location filename="../../ui/panels/monitor_panel.py" line="203" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="207" />
+            <location filename="../../ui/panels/monitor_panel.py" line="204" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="214" />
+            <location filename="../../ui/panels/monitor_panel.py" line="211" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="215" />
+            <location filename="../../ui/panels/monitor_panel.py" line="212" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="216" />
+            <location filename="../../ui/panels/monitor_panel.py" line="213" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="216" />
+            <location filename="../../ui/panels/monitor_panel.py" line="213" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="217" />
+            <location filename="../../ui/panels/monitor_panel.py" line="214" />
             <source>Top view (X–Y)</source>
             <translation>俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="236" />
+            <location filename="../../ui/panels/monitor_panel.py" line="233" />
             <source>Stale: not confirmed by the controller within the freshness limit</source>
             <translation>数据过期：未在时效内得到控制器确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="435" />
+            <location filename="../../ui/panels/monitor_panel.py" line="432" />
             <source>values stale (grey): no fresh data from the controller</source>
             <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="431" />
+            <location filename="../../ui/panels/monitor_panel.py" line="428" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="433" />
+            <location filename="../../ui/panels/monitor_panel.py" line="430" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
@@ -3010,42 +3010,42 @@
     <context>
         <name>Panels</name>
         <message>
-            <location filename="../../ui/widgets_common.py" line="360" />
+            <location filename="../../ui/widgets_common.py" line="333" />
             <source>connected</source>
             <translation>已连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="361" />
+            <location filename="../../ui/widgets_common.py" line="334" />
             <source>connecting</source>
             <translation>正在连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="364" />
+            <location filename="../../ui/widgets_common.py" line="337" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="363" />
+            <location filename="../../ui/widgets_common.py" line="336" />
             <source>link down</source>
             <translation>链路中断</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="388" />
+            <location filename="../../ui/widgets_common.py" line="361" />
             <source>failed</source>
             <translation>失败</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="379" />
+            <location filename="../../ui/widgets_common.py" line="352" />
             <source>command</source>
             <translation>命令</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="362" />
+            <location filename="../../ui/widgets_common.py" line="335" />
             <source>not answering</source>
             <translation>无应答</translation>
         </message>
         <message>
-            <location filename="../../ui/widgets_common.py" line="387" />
+            <location filename="../../ui/widgets_common.py" line="360" />
             <source>done</source>
             <translation>完成</translation>
         </message>
@@ -3156,13 +3156,13 @@
     <context>
         <name>Plan</name>
         <message>
-            <location filename="../../app/plan/segments.py" line="57" />
+            <location filename="../../app/plan/segments.py" line="56" />
             <source>line</source>
             <extracomment>Editable fields of a segment, in table column order.</extracomment>
             <translation>直线</translation>
         </message>
         <message>
-            <location filename="../../app/plan/segments.py" line="58" />
+            <location filename="../../app/plan/segments.py" line="57" />
             <source>arc</source>
             <translation>圆弧</translation>
         </message>
@@ -3298,88 +3298,88 @@
     <context>
         <name>PlanPreview</name>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="254" />
+            <location filename="../../ui/panels/plan_preview.py" line="253" />
             <source>Top (XY)</source>
             <extracomment>px: a narrower preview shows one projection at a time (its tabs), the lengths / times below it (key, horizontal axis, vertical axis) — 0 = X, 1 = Y, 2 = Z.</extracomment>
             <translation>俯视（XY）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="255" />
+            <location filename="../../ui/panels/plan_preview.py" line="254" />
             <source>Front (XZ)</source>
             <translation>正视（XZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="256" />
+            <location filename="../../ui/panels/plan_preview.py" line="255" />
             <source>Side (YZ)</source>
             <translation>侧视（YZ）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="261" />
+            <location filename="../../ui/panels/plan_preview.py" line="260" />
             <source>Top</source>
             <translation>俯视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="262" />
+            <location filename="../../ui/panels/plan_preview.py" line="261" />
             <source>Front</source>
             <translation>正视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="263" />
+            <location filename="../../ui/panels/plan_preview.py" line="262" />
             <source>Side</source>
             <translation>侧视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="268" />
+            <location filename="../../ui/panels/plan_preview.py" line="267" />
             <source>Fit</source>
             <translation>适应</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="271" />
+            <location filename="../../ui/panels/plan_preview.py" line="270" />
             <source>Fit the views to the plan; they follow every change again until you zoom or pan</source>
             <translation>使视图适应整个计划；之后每次修改都会重新适应，直到您缩放或平移</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="330" />
+            <location filename="../../ui/panels/plan_preview.py" line="329" />
             <source>Reach: robot model “%1”</source>
             <translation>可达性：机器人模型“%1”</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="401" />
+            <location filename="../../ui/panels/plan_preview.py" line="400" />
             <source>endless</source>
             <translation>无限循环</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="402" />
+            <location filename="../../ui/panels/plan_preview.py" line="401" />
             <source>&lt;b&gt;{name}&lt;/b&gt;: {n} segments, loops: {loops}</source>
             <translation>&lt;b&gt;{name}&lt;/b&gt;：{n} 段，循环次数：{loops}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="406" />
+            <location filename="../../ui/panels/plan_preview.py" line="405" />
             <source>One loop: {length}, {time}</source>
             <translation>单次循环：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="407" />
+            <location filename="../../ui/panels/plan_preview.py" line="406" />
             <source>Total: {length}, {time}</source>
             <translation>合计：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="411" />
+            <location filename="../../ui/panels/plan_preview.py" line="410" />
             <source>Not counted (unknown length): segments {list}</source>
             <translation>未计入（长度未知）：第 {list} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="419" />
+            <location filename="../../ui/panels/plan_preview.py" line="418" />
             <source>Segment {k}: {length}, {time}</source>
             <translation>第 {k} 段：{length}，{time}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="422" />
+            <location filename="../../ui/panels/plan_preview.py" line="421" />
             <source>Start: end of the last segment (robot pose unknown)</source>
             <translation>起点：最后一段的终点（机器人位姿未知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/plan_preview.py" line="424" />
+            <location filename="../../ui/panels/plan_preview.py" line="423" />
             <source>Start: the robot's current pose</source>
             <translation>起点：机器人当前位姿</translation>
         </message>
@@ -3459,83 +3459,83 @@
     <context>
         <name>PlanRunFlow</name>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="77" />
+            <location filename="../../ui/panels/planner_run.py" line="79" />
             <source>The plan has no segments</source>
             <translation>轨迹没有任何段</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="80" />
+            <location filename="../../ui/panels/planner_run.py" line="82" />
             <source>Wait until the point upload or move ends</source>
             <translation>请等待点的上传或运动结束</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="105" />
+            <location filename="../../ui/panels/planner_run.py" line="107" />
             <source>Cannot run: the plan has %n error(s); the first: {message}</source>
             <translation>
                 <numerusform>无法运行：计划有 %n 个错误，第一个：{message}</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="114" />
+            <location filename="../../ui/panels/planner_run.py" line="116" />
             <source>Cannot run: %n point(s) need upload</source>
             <translation>
                 <numerusform>无法运行：%n 个点需要上传</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/planner_run.py" line="116" />
+            <location filename="../../ui/panels/planner_run.py" line="118" />
             <source>%n point(s) of the plan are not on the controller: </source>
             <translation>
                 <numerusform>轨迹中有 %n 个点不在控制器上：</numerusform>
             </translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="118" />
+            <location filename="../../ui/panels/planner_run.py" line="120" />
             <source>Upload now, then run?</source>
             <translation>立即上传后运行？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="119" />
+            <location filename="../../ui/panels/planner_run.py" line="121" />
             <source>Upload points</source>
             <translation>上传点</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="131" />
+            <location filename="../../ui/panels/planner_run.py" line="133" />
             <source>Resume plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段继续运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="133" />
+            <location filename="../../ui/panels/planner_run.py" line="135" />
             <source>Run segment {k} of plan '{name}' (one step)?</source>
             <translation>单步运行轨迹“{name}”的第 {k} 段？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="135" />
+            <location filename="../../ui/panels/planner_run.py" line="137" />
             <source>Run plan '{name}' from segment {k}?</source>
             <translation>从第 {k} 段开始运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="137" />
+            <location filename="../../ui/panels/planner_run.py" line="139" />
             <source>Run plan '{name}'?</source>
             <translation>运行轨迹“{name}”？</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="138" />
+            <location filename="../../ui/panels/planner_run.py" line="140" />
             <source>The robot will move.</source>
             <translation>机器人将会运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="141" />
+            <location filename="../../ui/panels/planner_run.py" line="143" />
             <source>Warnings:</source>
             <translation>警告：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="145" />
+            <location filename="../../ui/panels/planner_run.py" line="147" />
             <source>Run plan</source>
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="200" />
+            <location filename="../../ui/panels/planner_run.py" line="202" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
@@ -3788,159 +3788,159 @@
     <context>
         <name>PointSyncController</name>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="171" />
+            <location filename="../../ui/controllers/point_sync.py" line="172" />
             <source>Teach</source>
             <translation>示教</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="182" />
+            <location filename="../../ui/controllers/point_sync.py" line="183" />
             <source>Teaching P{id} at the current pose…</source>
             <translation>正在以当前位姿示教 P{id}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="192" />
+            <location filename="../../ui/controllers/point_sync.py" line="193" />
             <source>No points to upload</source>
             <translation>没有要上传的点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="194" />
+            <location filename="../../ui/controllers/point_sync.py" line="195" />
             <source>Upload</source>
             <translation>上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="201" />
+            <location filename="../../ui/controllers/point_sync.py" line="202" />
             <source>Uploading {n} points…</source>
             <translation>正在上传 {n} 个点…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="227" />
+            <location filename="../../ui/controllers/point_sync.py" line="228" />
             <source>Cancelling the upload…</source>
             <translation>正在取消上传…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="235" />
+            <location filename="../../ui/controllers/point_sync.py" line="236" />
             <source>There is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="238" />
+            <location filename="../../ui/controllers/point_sync.py" line="239" />
             <source>Speed {v} mm/s is out of range</source>
             <translation>速度 {v} mm/s 超出范围</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="240" />
+            <location filename="../../ui/controllers/point_sync.py" line="241" />
             <source>Move</source>
             <translation>运动</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="249" />
+            <location filename="../../ui/controllers/point_sync.py" line="250" />
             <source>Moving to {point} at {v} mm/s…</source>
             <translation>正在以 {v} mm/s 运动到 {point}…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="304" />
+            <location filename="../../ui/controllers/point_sync.py" line="305" />
             <source>The controller does not hold the plan's points (did it restart?): Restore all to re-create them.</source>
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="327" />
+            <location filename="../../ui/controllers/point_sync.py" line="328" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="330" />
+            <location filename="../../ui/controllers/point_sync.py" line="331" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="361" />
+            <location filename="../../ui/controllers/point_sync.py" line="362" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="382" />
+            <location filename="../../ui/controllers/point_sync.py" line="383" />
             <source>Connected to another controller ({endpoint}): {n} points are not known to be on it. Restore all to create them there.</source>
             <translation>已连接到另一台控制器（{endpoint}）：不知道它是否保存着这 {n} 个点。点击“恢复全部”在其上创建它们。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="387" />
+            <location filename="../../ui/controllers/point_sync.py" line="388" />
             <source>The controller restarted, or it is not the one the points were uploaded to: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启，或不是上传这些点的那台控制器：其上可能已没有这 {n} 个点。点击“恢复全部”重新创建它们。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="415" />
+            <location filename="../../ui/controllers/point_sync.py" line="416" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="424" />
+            <location filename="../../ui/controllers/point_sync.py" line="425" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="435" />
+            <location filename="../../ui/controllers/point_sync.py" line="436" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="440" />
+            <location filename="../../ui/controllers/point_sync.py" line="441" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="450" />
+            <location filename="../../ui/controllers/point_sync.py" line="451" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="459" />
+            <location filename="../../ui/controllers/point_sync.py" line="460" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="464" />
+            <location filename="../../ui/controllers/point_sync.py" line="465" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="484" />
+            <location filename="../../ui/controllers/point_sync.py" line="485" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="269" />
-            <location filename="../../ui/controllers/point_sync.py" line="488" />
+            <location filename="../../ui/controllers/point_sync.py" line="270" />
+            <location filename="../../ui/controllers/point_sync.py" line="489" />
             <source>Move to P{id} stopped by the operator</source>
             <translation>运动到 P{id} 已由操作员停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="496" />
-            <location filename="../../ui/controllers/point_sync.py" line="505" />
+            <location filename="../../ui/controllers/point_sync.py" line="497" />
+            <location filename="../../ui/controllers/point_sync.py" line="506" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="551" />
+            <location filename="../../ui/controllers/point_sync.py" line="552" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="554" />
+            <location filename="../../ui/controllers/point_sync.py" line="555" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="566" />
+            <location filename="../../ui/controllers/point_sync.py" line="567" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="571" />
+            <location filename="../../ui/controllers/point_sync.py" line="572" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="578" />
+            <location filename="../../ui/controllers/point_sync.py" line="579" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -3948,28 +3948,28 @@
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points/point.py" line="202" />
+            <location filename="../../app/points/point.py" line="179" />
             <source>unknown</source>
             <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host". Sent without an error, but the controller's status never changed (observe rule): most likely on the controller, not proven. Still needs an upload before a move relies on it.</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="203" />
+            <location filename="../../app/points/point.py" line="180" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="204" />
+            <location filename="../../app/points/point.py" line="181" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="205" />
+            <location filename="../../app/points/point.py" line="182" />
             <source>upload failed</source>
             <translation>上传失败</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="206" />
+            <location filename="../../app/points/point.py" line="183" />
             <source>on controller, unconfirmed</source>
             <translation>已在控制器上（未确认）</translation>
         </message>
@@ -3977,160 +3977,160 @@
     <context>
         <name>PointsModel</name>
         <message>
-            <location filename="../../ui/messages_plan.py" line="163" />
-            <location filename="../../ui/models/point_columns.py" line="67" />
+            <location filename="../../ui/messages_plan.py" line="162" />
+            <location filename="../../ui/models/point_columns.py" line="63" />
             <source>none</source>
             <extracomment>Columns of the table: the point's fields in CSV order, with the sync state before the note. Custom roles. Text the tool cell accepts for "no tool frame" besides 200.</extracomment>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/messages_plan.py" line="164" />
-            <location filename="../../ui/models/point_columns.py" line="68" />
+            <location filename="../../ui/messages_plan.py" line="163" />
+            <location filename="../../ui/models/point_columns.py" line="64" />
             <source>tool {n}</source>
             <translation>工具 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="135" />
+            <location filename="../../ui/models/points_model.py" line="127" />
             <source>ID</source>
             <translation>编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="136" />
+            <location filename="../../ui/models/points_model.py" line="128" />
             <source>Name</source>
             <translation>名称</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="137" />
+            <location filename="../../ui/models/points_model.py" line="129" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="138" />
+            <location filename="../../ui/models/points_model.py" line="130" />
             <source>Sync</source>
             <translation>同步状态</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="139" />
+            <location filename="../../ui/models/points_model.py" line="131" />
             <source>Note</source>
             <translation>备注</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="146" />
+            <location filename="../../ui/models/points_model.py" line="138" />
             <source>Temp point id on the controller</source>
             <translation>控制器上的临时点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="147" />
+            <location filename="../../ui/models/points_model.py" line="139" />
             <source>Tool frame (200 = none)</source>
             <translation>工具坐标系（200 = 无）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="148" />
+            <location filename="../../ui/models/points_model.py" line="140" />
             <source>Whether the controller holds this point</source>
             <translation>控制器上是否有此点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="149" />
+            <location filename="../../ui/models/points_model.py" line="141" />
             <source>mm, base frame</source>
             <translation>毫米，基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="150" />
+            <location filename="../../ui/models/points_model.py" line="142" />
             <source>degrees</source>
             <translation>度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="153" />
+            <location filename="../../ui/models/points_model.py" line="145" />
             <source>External axis (recorded only: the controller does not store it); CSV column {column}</source>
             <translation>外部轴（仅记录：控制器不保存）；CSV 列 {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="221" />
+            <location filename="../../ui/models/points_model.py" line="213" />
             <source>no reason given</source>
             <translation>未给出原因</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="222" />
+            <location filename="../../ui/models/points_model.py" line="214" />
             <source>Upload failed: {reason}</source>
             <translation>上传失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="225" />
+            <location filename="../../ui/models/points_model.py" line="217" />
             <source>Not known whether the controller holds this point (it restarted, it is another controller, or the arm did not arrive there): a move to it creates it again first</source>
             <translation>不知道控制器是否保存着此点（控制器已重启、是另一台控制器，或机械臂未到达该点）：移动到此点时会先重新创建它</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="229" />
+            <location filename="../../ui/models/points_model.py" line="221" />
             <source>The controller holds this point with these values</source>
             <translation>控制器上的此点与这些数值一致</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="230" />
+            <location filename="../../ui/models/points_model.py" line="222" />
             <source>Changed on the host (or new) since the last upload</source>
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="232" />
+            <location filename="../../ui/models/points_model.py" line="224" />
             <source>Sent without an error, but the controller's status never changed: most likely there, not proven; upload it again before moving to it</source>
             <translation>发送无错误，但控制器状态一直未变：很可能已在控制器上，但未经证实；移动到该点前请重新上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="240" />
+            <location filename="../../ui/models/points_model.py" line="232" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="287" />
+            <location filename="../../ui/models/points_model.py" line="279" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="316" />
+            <location filename="../../ui/models/points_model.py" line="308" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="333" />
+            <location filename="../../ui/models/points_model.py" line="325" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="362" />
+            <location filename="../../ui/models/points_model.py" line="354" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="364" />
+            <location filename="../../ui/models/points_model.py" line="356" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="383" />
+            <location filename="../../ui/models/points_model.py" line="375" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="385" />
+            <location filename="../../ui/models/points_model.py" line="377" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="401" />
+            <location filename="../../ui/models/points_model.py" line="393" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="401" />
+            <location filename="../../ui/models/points_model.py" line="393" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="424" />
+            <location filename="../../ui/models/points_model.py" line="416" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="444" />
+            <location filename="../../ui/models/points_model.py" line="436" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -4709,166 +4709,166 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
     <context>
         <name>ProjectController</name>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="150" />
+            <location filename="../../ui/controllers/project_controller.py" line="143" />
             <source>Undo</source>
             <extracomment>The longest a close, a save or a discard waits for the autosave being written (s): a 58 MB project is written in about a second; a stuck disk must not hold the window for ever.</extracomment>
             <translation>撤销</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="152" />
+            <location filename="../../ui/controllers/project_controller.py" line="145" />
             <source>Redo</source>
             <translation>重做</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="156" />
+            <location filename="../../ui/controllers/project_controller.py" line="149" />
             <source>&amp;New project</source>
             <translation>新建工程(&amp;N)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="157" />
+            <location filename="../../ui/controllers/project_controller.py" line="150" />
             <source>&amp;Open project…</source>
             <translation>打开工程(&amp;O)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="158" />
+            <location filename="../../ui/controllers/project_controller.py" line="151" />
             <source>&amp;Save project</source>
             <translation>保存工程(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="159" />
+            <location filename="../../ui/controllers/project_controller.py" line="152" />
             <source>Save project &amp;as…</source>
             <translation>工程另存为(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="160" />
+            <location filename="../../ui/controllers/project_controller.py" line="153" />
             <source>&amp;Import points (CSV)…</source>
             <translation>导入点 (CSV)(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="161" />
+            <location filename="../../ui/controllers/project_controller.py" line="154" />
             <source>&amp;Export points (CSV)…</source>
             <translation>导出点 (CSV)(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="191" />
+            <location filename="../../ui/controllers/project_controller.py" line="184" />
             <source>untitled</source>
             <translation>未命名</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="226" />
+            <location filename="../../ui/controllers/project_controller.py" line="219" />
             <source>Open project</source>
             <translation>打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="234" />
-            <location filename="../../ui/controllers/project_controller.py" line="272" />
-            <location filename="../../ui/controllers/project_controller.py" line="426" />
+            <location filename="../../ui/controllers/project_controller.py" line="227" />
+            <location filename="../../ui/controllers/project_controller.py" line="265" />
+            <location filename="../../ui/controllers/project_controller.py" line="419" />
             <source>Project in use</source>
             <translation>工程正在使用中</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="239" />
-            <location filename="../../ui/controllers/project_controller.py" line="242" />
+            <location filename="../../ui/controllers/project_controller.py" line="232" />
+            <location filename="../../ui/controllers/project_controller.py" line="235" />
             <source>Cannot open project</source>
             <translation>无法打开工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="245" />
+            <location filename="../../ui/controllers/project_controller.py" line="238" />
             <source>Opened {path}</source>
             <translation>已打开 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="257" />
+            <location filename="../../ui/controllers/project_controller.py" line="250" />
             <source>Save project</source>
             <translation>保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="278" />
-            <location filename="../../ui/controllers/project_controller.py" line="281" />
+            <location filename="../../ui/controllers/project_controller.py" line="271" />
+            <location filename="../../ui/controllers/project_controller.py" line="274" />
             <source>Cannot save project</source>
             <translation>无法保存工程</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="293" />
+            <location filename="../../ui/controllers/project_controller.py" line="286" />
             <source>Saved {path}</source>
             <translation>已保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="299" />
+            <location filename="../../ui/controllers/project_controller.py" line="292" />
             <source>Import points</source>
             <translation>导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="306" />
-            <location filename="../../ui/controllers/project_controller.py" line="309" />
-            <location filename="../../ui/controllers/project_controller.py" line="324" />
+            <location filename="../../ui/controllers/project_controller.py" line="299" />
+            <location filename="../../ui/controllers/project_controller.py" line="302" />
+            <location filename="../../ui/controllers/project_controller.py" line="317" />
             <source>Cannot import points</source>
             <translation>无法导入点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="326" />
+            <location filename="../../ui/controllers/project_controller.py" line="319" />
             <source>{added} added, {updated} updated, {unchanged} unchanged, {removed} removed</source>
             <translation>新增 {added} 个，更新 {updated} 个，未变 {unchanged} 个，删除 {removed} 个</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="329" />
+            <location filename="../../ui/controllers/project_controller.py" line="322" />
             <source>Imported {path}: {report}</source>
             <translation>已导入 {path}：{report}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="342" />
+            <location filename="../../ui/controllers/project_controller.py" line="335" />
             <source>Export points</source>
             <translation>导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="349" />
+            <location filename="../../ui/controllers/project_controller.py" line="342" />
             <source>Cannot export points</source>
             <translation>无法导出点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="352" />
+            <location filename="../../ui/controllers/project_controller.py" line="345" />
             <source>Exported {n} points to {path}</source>
             <translation>已导出 {n} 个点到 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="400" />
+            <location filename="../../ui/controllers/project_controller.py" line="393" />
             <source>Autosave failed: {reason}</source>
             <translation>自动保存失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="408" />
-            <location filename="../../ui/controllers/project_controller.py" line="461" />
+            <location filename="../../ui/controllers/project_controller.py" line="401" />
+            <location filename="../../ui/controllers/project_controller.py" line="454" />
             <source>The autosave {path} is still being written after {seconds} s.</source>
             <translation>自动保存 {path} 在 {seconds} 秒后仍在写入。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="442" />
-            <location filename="../../ui/controllers/project_controller.py" line="445" />
+            <location filename="../../ui/controllers/project_controller.py" line="435" />
+            <location filename="../../ui/controllers/project_controller.py" line="438" />
             <source>Cannot recover autosave</source>
             <translation>无法恢复自动保存</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="448" />
+            <location filename="../../ui/controllers/project_controller.py" line="441" />
             <source>Recovered the autosave {path}</source>
             <translation>已恢复自动保存 {path}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="495" />
+            <location filename="../../ui/controllers/project_controller.py" line="488" />
             <source>Cannot lock {path}: {reason}</source>
             <translation>无法锁定 {path}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="505" />
+            <location filename="../../ui/controllers/project_controller.py" line="498" />
             <source>{path} is open in another TeachPad (process {pid} on {host}, since {started}). Close it there first; its autosave belongs to that TeachPad and is not offered for recovery here.</source>
             <translation>{path} 已在另一个 TeachPad 中打开（主机 {host} 上的进程 {pid}，自 {started} 起）。请先在那里关闭它；它的自动保存属于那个 TeachPad，此处不提供恢复。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="542" />
+            <location filename="../../ui/controllers/project_controller.py" line="535" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="545" />
+            <location filename="../../ui/controllers/project_controller.py" line="538" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>
@@ -5353,7 +5353,7 @@ Remove them all?</source>
     <context>
         <name>RobotModelSource</name>
         <message>
-            <location filename="../../ui/panels/view3d_robot.py" line="184" />
+            <location filename="../../ui/panels/view3d_robot.py" line="185" />
             <source>The robot model remembered from the last session could not be loaded: %1. The default robot model (%2) is used.</source>
             <translation>上次使用的机器人模型无法加载：%1。现使用默认机器人模型（%2）。</translation>
         </message>
@@ -5536,112 +5536,112 @@ Remove them all?</source>
     <context>
         <name>SafetyMenu</name>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="111" />
+            <location filename="../../ui/controllers/safety_menu.py" line="143" />
             <source>&amp;Safety</source>
             <translation>安全(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="112" />
+            <location filename="../../ui/controllers/safety_menu.py" line="144" />
             <source>Log &amp;in…</source>
             <translation>登录(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="113" />
+            <location filename="../../ui/controllers/safety_menu.py" line="145" />
             <source>Log &amp;out (operator)</source>
             <translation>注销(&amp;O)（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="114" />
+            <location filename="../../ui/controllers/safety_menu.py" line="146" />
             <source>&amp;Reduced speed</source>
             <translation>降速模式(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="115" />
+            <location filename="../../ui/controllers/safety_menu.py" line="147" />
             <source>Safety &amp;envelope…</source>
             <translation>安全范围(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="116" />
+            <location filename="../../ui/controllers/safety_menu.py" line="148" />
             <source>Re&amp;gister profile…</source>
             <translation>寄存器配置(&amp;G)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="118" />
+            <location filename="../../ui/controllers/safety_menu.py" line="150" />
             <source>Word order, unit id, completion rule, poll timeout (administrator)</source>
             <translation>字序、从站地址、完成判定、轮询超时（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="120" />
+            <location filename="../../ui/controllers/safety_menu.py" line="152" />
             <source>&amp;Passwords and lock…</source>
             <translation>密码与锁定(&amp;P)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="122" />
+            <location filename="../../ui/controllers/safety_menu.py" line="154" />
             <source>Set, change or clear passwords; the idle lock time (administrator)</source>
             <translation>设置、修改或清除密码；空闲锁定时间（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="124" />
+            <location filename="../../ui/controllers/safety_menu.py" line="156" />
             <source>&amp;Audit trail…</source>
             <translation>审计记录(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="125" />
+            <location filename="../../ui/controllers/safety_menu.py" line="157" />
             <source>Write a &amp;support bundle…</source>
             <translation>生成支持包(&amp;S)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="138" />
+            <location filename="../../ui/controllers/safety_menu.py" line="170" />
             <source>Role: {role} · reduced speed</source>
             <translation>角色：{role} · 降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="138" />
+            <location filename="../../ui/controllers/safety_menu.py" line="170" />
             <source>Role: {role}</source>
             <translation>角色：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="148" />
+            <location filename="../../ui/controllers/safety_menu.py" line="180" />
             <source>Cap jog and move speeds (anyone may switch it on)</source>
             <translation>限制点动与移动速度（任何人都可开启）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="161" />
+            <location filename="../../ui/controllers/safety_menu.py" line="193" />
             <source>safety</source>
             <translation>安全</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="224" />
+            <location filename="../../ui/controllers/safety_menu.py" line="256" />
             <source>The register profile could not be saved: {why}</source>
             <translation>寄存器配置无法保存：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="229" />
+            <location filename="../../ui/controllers/safety_menu.py" line="261" />
             <source>Register profile “{name}” saved (revision {rev})</source>
             <translation>寄存器配置“{name}”已保存（第 {rev} 版）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="243" />
+            <location filename="../../ui/controllers/safety_menu.py" line="275" />
             <source>Zip files (*.zip)</source>
             <translation>Zip 文件 (*.zip)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="250" />
+            <location filename="../../ui/controllers/safety_menu.py" line="282" />
             <source>Write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="281" />
+            <location filename="../../ui/controllers/safety_menu.py" line="313" />
             <source>The support bundle could not be written: {why}</source>
             <translation>无法生成支持包：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="284" />
+            <location filename="../../ui/controllers/safety_menu.py" line="316" />
             <source>Support bundle</source>
             <translation>支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="290" />
+            <location filename="../../ui/controllers/safety_menu.py" line="322" />
             <source>Support bundle written: {file} ({n} files)</source>
             <translation>支持包已生成：{file}（{n} 个文件）</translation>
         </message>
@@ -5662,27 +5662,27 @@ Remove them all?</source>
     <context>
         <name>SegmentTableModel</name>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="119" />
+            <location filename="../../ui/models/segment_model.py" line="121" />
             <source>Type</source>
             <translation>类型</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="120" />
+            <location filename="../../ui/models/segment_model.py" line="122" />
             <source>Middle point</source>
             <translation>中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="121" />
+            <location filename="../../ui/models/segment_model.py" line="123" />
             <source>End point</source>
             <translation>终点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="123" />
+            <location filename="../../ui/models/segment_model.py" line="125" />
             <source>Orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="125" />
+            <location filename="../../ui/models/segment_model.py" line="127" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
@@ -5712,122 +5712,122 @@ Remove them all?</source>
             <translation>警告</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="118" />
+            <location filename="../../ui/models/segment_model.py" line="120" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="122" />
+            <location filename="../../ui/models/segment_model.py" line="124" />
             <source>Speed</source>
             <translation>速度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="124" />
+            <location filename="../../ui/models/segment_model.py" line="126" />
             <source>Ignore mid.</source>
             <translation>忽略中间点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="126" />
+            <location filename="../../ui/models/segment_model.py" line="128" />
             <source>Length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="127" />
+            <location filename="../../ui/models/segment_model.py" line="129" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="218" />
+            <location filename="../../ui/models/segment_model.py" line="220" />
             <source>Checks before running: hover the icon for details</source>
             <translation>运行前检查：鼠标悬停在图标上查看详情</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="219" />
+            <location filename="../../ui/models/segment_model.py" line="221" />
             <source>Speed in mm/s (GV225)</source>
             <translation>速度，单位 mm/s（GV225）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="220" />
+            <location filename="../../ui/models/segment_model.py" line="222" />
             <source>Middle point of an arc (GV200)</source>
             <translation>圆弧的中间点（GV200）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="221" />
+            <location filename="../../ui/models/segment_model.py" line="223" />
             <source>End point (GV201)</source>
             <translation>终点（GV201）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="222" />
+            <location filename="../../ui/models/segment_model.py" line="224" />
             <source>Orientation kept constant or changing along the move (GV202)</source>
             <translation>运动中姿态保持不变或变化（GV202）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="223" />
+            <location filename="../../ui/models/segment_model.py" line="225" />
             <source>Ignore the arc's middle point orientation (GV203)</source>
             <translation>忽略圆弧中间点的姿态（GV203）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="224" />
+            <location filename="../../ui/models/segment_model.py" line="226" />
             <source>Tool frame of the move (GV245)</source>
             <translation>运动使用的工具坐标系（GV245）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="225" />
+            <location filename="../../ui/models/segment_model.py" line="227" />
             <source>Estimated path length</source>
             <translation>估计路径长度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="226" />
+            <location filename="../../ui/models/segment_model.py" line="228" />
             <source>Estimated time: length / speed plus a fixed overhead per segment</source>
             <translation>估计时间：长度 / 速度，加上每段固定开销</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="329" />
+            <location filename="../../ui/models/segment_model.py" line="331" />
             <source>Segment {n}: no problems found</source>
             <translation>第 {n} 段：未发现问题</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="334" />
+            <location filename="../../ui/models/segment_model.py" line="336" />
             <source>Point P{id} does not exist</source>
             <translation>点 P{id} 不存在</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="369" />
+            <location filename="../../ui/models/segment_model.py" line="371" />
             <source>Segment {n}, {column}: refused, {reason}</source>
             <translation>第 {n} 段，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="383" />
+            <location filename="../../ui/models/segment_model.py" line="385" />
             <source>Edit segment {n} {column}</source>
             <translation>编辑第 {n} 段 {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="395" />
+            <location filename="../../ui/models/segment_model.py" line="397" />
             <source>Add {kind} segment</source>
             <translation>添加{kind}段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="412" />
+            <location filename="../../ui/models/segment_model.py" line="414" />
             <source>Add {n} segments</source>
             <translation>添加 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="421" />
+            <location filename="../../ui/models/segment_model.py" line="423" />
             <source>Delete segment {n}</source>
             <translation>删除第 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="423" />
+            <location filename="../../ui/models/segment_model.py" line="425" />
             <source>Delete {n} segments</source>
             <translation>删除 {n} 段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="444" />
+            <location filename="../../ui/models/segment_model.py" line="446" />
             <source>Move segment up</source>
             <translation>上移段</translation>
         </message>
         <message>
-            <location filename="../../ui/models/segment_model.py" line="444" />
+            <location filename="../../ui/models/segment_model.py" line="446" />
             <source>Move segment down</source>
             <translation>下移段</translation>
         </message>
@@ -5835,142 +5835,142 @@ Remove them all?</source>
     <context>
         <name>StatusPanel</name>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="247" />
+            <location filename="../../ui/panels/status_panel.py" line="244" />
             <source>Link</source>
             <translation>通信链路</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="248" />
+            <location filename="../../ui/panels/status_panel.py" line="245" />
             <source>Controller</source>
             <translation>控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="249" />
-            <location filename="../../ui/panels/status_panel.py" line="325" />
+            <location filename="../../ui/panels/status_panel.py" line="246" />
+            <location filename="../../ui/panels/status_panel.py" line="322" />
             <source>Alarms</source>
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="249" />
-            <location filename="../../ui/panels/status_panel.py" line="325" />
+            <location filename="../../ui/panels/status_panel.py" line="246" />
+            <location filename="../../ui/panels/status_panel.py" line="322" />
             <source>Alarms (last known)</source>
             <translation>报警（最后已知）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="251" />
+            <location filename="../../ui/panels/status_panel.py" line="248" />
             <source>State:</source>
             <translation>状态：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="252" />
+            <location filename="../../ui/panels/status_panel.py" line="249" />
             <source>RTT:</source>
             <translation>往返时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="253" />
+            <location filename="../../ui/panels/status_panel.py" line="250" />
             <source>Mode:</source>
             <translation>模式：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="254" />
+            <location filename="../../ui/panels/status_panel.py" line="251" />
             <source>Program:</source>
             <translation>程序：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="255" />
+            <location filename="../../ui/panels/status_panel.py" line="252" />
             <source>Last command:</source>
             <translation>上一条命令：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="256" />
+            <location filename="../../ui/panels/status_panel.py" line="253" />
             <source>Clock:</source>
             <translation>系统时间：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="257" />
+            <location filename="../../ui/panels/status_panel.py" line="254" />
             <source>Drift:</source>
             <translation>时差：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="258" />
+            <location filename="../../ui/panels/status_panel.py" line="255" />
             <source>Round-trip time of the last poll</source>
             <translation>最近一次轮询的往返时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="266" />
+            <location filename="../../ui/panels/status_panel.py" line="263" />
             <source>Register 562 bit {bit}</source>
             <translation>寄存器 562 第 {bit} 位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="267" />
+            <location filename="../../ui/panels/status_panel.py" line="264" />
             <source>Register 562 bits with no documented meaning</source>
             <translation>寄存器 562 中未定义含义的位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="272" />
+            <location filename="../../ui/panels/status_panel.py" line="269" />
             <source>disconnected</source>
             <translation>未连接</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="281" />
+            <location filename="../../ui/panels/status_panel.py" line="278" />
             <source>none yet</source>
             <translation>暂无</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="391" />
+            <location filename="../../ui/panels/status_panel.py" line="388" />
             <source>unknown</source>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="409" />
+            <location filename="../../ui/panels/status_panel.py" line="406" />
             <source>other bits: {bits}</source>
             <translation>其他位：{bits}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="411" />
+            <location filename="../../ui/panels/status_panel.py" line="408" />
             <source>other bits</source>
             <translation>其他位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="423" />
+            <location filename="../../ui/panels/status_panel.py" line="420" />
             <source>monitor only: writes blocked</source>
             <translation>仅监视：禁止写入</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="259" />
-            <location filename="../../ui/panels/status_panel.py" line="431" />
+            <location filename="../../ui/panels/status_panel.py" line="256" />
+            <location filename="../../ui/panels/status_panel.py" line="428" />
             <source>{ms} ms</source>
             <translation>{ms} ms</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="448" />
+            <location filename="../../ui/panels/status_panel.py" line="445" />
             <source>GV291 code: {code}</source>
             <translation>GV291 返回码：{code}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="456" />
+            <location filename="../../ui/panels/status_panel.py" line="453" />
             <source>Raw words {first}..{last}: {words}</source>
             <translation>寄存器 {first}..{last} 原始值：{words}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="460" />
+            <location filename="../../ui/panels/status_panel.py" line="457" />
             <source>Controller clock minus PC clock</source>
             <translation>控制器时间减去电脑时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="464" />
+            <location filename="../../ui/panels/status_panel.py" line="461" />
             <source>invalid date/time</source>
             <translation>日期/时间无效</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="261" />
-            <location filename="../../ui/panels/status_panel.py" line="470" />
+            <location filename="../../ui/panels/status_panel.py" line="258" />
+            <location filename="../../ui/panels/status_panel.py" line="467" />
             <source>{drift} s</source>
             <translation>{drift} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/status_panel.py" line="262" />
-            <location filename="../../ui/panels/status_panel.py" line="473" />
+            <location filename="../../ui/panels/status_panel.py" line="259" />
+            <location filename="../../ui/panels/status_panel.py" line="470" />
             <source>{value} (stale)</source>
             <translation>{value}（已过期）</translation>
         </message>
@@ -6108,37 +6108,37 @@ Remove them all?</source>
     <context>
         <name>TrafficModel</name>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="105" />
+            <location filename="../../ui/models/traffic_model.py" line="103" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="106" />
+            <location filename="../../ui/models/traffic_model.py" line="104" />
             <source>Dir</source>
             <translation>方向</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="107" />
+            <location filename="../../ui/models/traffic_model.py" line="105" />
             <source>Bytes</source>
             <translation>字节</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="108" />
+            <location filename="../../ui/models/traffic_model.py" line="106" />
             <source>Meaning</source>
             <translation>含义</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="110" />
+            <location filename="../../ui/models/traffic_model.py" line="108" />
             <source>→ Tx</source>
             <translation>→ 发送</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="111" />
+            <location filename="../../ui/models/traffic_model.py" line="109" />
             <source>← Rx</source>
             <translation>← 接收</translation>
         </message>
         <message>
-            <location filename="../../ui/models/traffic_model.py" line="384" />
+            <location filename="../../ui/models/traffic_model.py" line="382" />
             <source>{n} bytes</source>
             <translation>{n} 字节</translation>
         </message>
@@ -6391,171 +6391,171 @@ Remove them all?</source>
     <context>
         <name>View3DPanel</name>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="234" />
+            <location filename="../../ui/panels/view3d_panel.py" line="230" />
             <source>Top</source>
             <translation>俯视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="235" />
+            <location filename="../../ui/panels/view3d_panel.py" line="231" />
             <source>Front</source>
             <translation>正视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="236" />
+            <location filename="../../ui/panels/view3d_panel.py" line="232" />
             <source>Side</source>
             <translation>侧视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="237" />
+            <location filename="../../ui/panels/view3d_panel.py" line="233" />
             <source>Iso</source>
             <translation>轴测</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="241" />
+            <location filename="../../ui/panels/view3d_panel.py" line="237" />
             <source>Look at the scene from a preset direction</source>
             <translation>从预设方向观察场景</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="242" />
+            <location filename="../../ui/panels/view3d_panel.py" line="238" />
             <source>Fit all</source>
             <translation>全部显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="244" />
+            <location filename="../../ui/panels/view3d_panel.py" line="240" />
             <source>Show the arm, the points and the plan (the view follows them again until you move it)</source>
             <translation>显示机械臂、点位和轨迹（在您移动视图之前，视图会自动跟随它们）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="246" />
+            <location filename="../../ui/panels/view3d_panel.py" line="242" />
             <source>Fit plan</source>
             <translation>缩放至轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="247" />
+            <location filename="../../ui/panels/view3d_panel.py" line="243" />
             <source>Show the selected plan's path and its points</source>
             <translation>显示所选轨迹的路径及其点位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="248" />
+            <location filename="../../ui/panels/view3d_panel.py" line="244" />
             <source>Orthographic</source>
             <translation>正交投影</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="249" />
+            <location filename="../../ui/panels/view3d_panel.py" line="245" />
             <source>Parallel projection (no perspective)</source>
             <translation>平行投影（无透视）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="250" />
+            <location filename="../../ui/panels/view3d_panel.py" line="246" />
             <source>Robot model…</source>
             <translation>机器人模型…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="251" />
+            <location filename="../../ui/panels/view3d_panel.py" line="247" />
             <source>Load another robot model profile (JSON; engineer)</source>
             <translation>加载其他机器人模型配置文件（JSON；需工程师）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="253" />
+            <location filename="../../ui/panels/view3d_panel.py" line="249" />
             <source>Beside the planner</source>
             <translation>在规划器旁显示</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="254" />
+            <location filename="../../ui/panels/view3d_panel.py" line="250" />
             <source>Show the 3D view next to the planner, not in its own tab</source>
             <translation>将 3D 视图显示在规划器旁边，而不是单独的标签页</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="256" />
+            <location filename="../../ui/panels/view3d_panel.py" line="252" />
             <source>Drag: rotate · Shift or right drag: pan · Wheel: zoom · Click a point: select it</source>
             <translation>拖动：旋转 · Shift 或右键拖动：平移 · 滚轮：缩放 · 单击点位：选中</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="290" />
-            <location filename="../../ui/panels/view3d_panel.py" line="339" />
+            <location filename="../../ui/panels/view3d_panel.py" line="286" />
+            <location filename="../../ui/panels/view3d_panel.py" line="335" />
             <source>Robot model not loaded: %1</source>
             <translation>未加载机器人模型：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="299" />
-            <location filename="../../ui/panels/view3d_panel.py" line="301" />
+            <location filename="../../ui/panels/view3d_panel.py" line="295" />
+            <location filename="../../ui/panels/view3d_panel.py" line="297" />
             <source>Robot model: %1</source>
             <translation>机器人模型：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="302" />
+            <location filename="../../ui/panels/view3d_panel.py" line="298" />
             <source>File: %1</source>
             <translation>文件：%1</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="304" />
+            <location filename="../../ui/panels/view3d_panel.py" line="300" />
             <source>Shipped with TeachPad</source>
             <translation>TeachPad 自带</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="308" />
+            <location filename="../../ui/panels/view3d_panel.py" line="304" />
             <source>Not compared with the controller (no joint angles from it)</source>
             <translation>未与控制器比对（控制器未提供关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="311" />
+            <location filename="../../ui/panels/view3d_panel.py" line="307" />
             <source>Agrees with the controller's pose (within %1 mm, %2°)</source>
             <translation>与控制器的位姿一致（误差在 %1 mm、%2° 以内）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="345" />
+            <location filename="../../ui/panels/view3d_panel.py" line="341" />
             <source>Load a robot model profile</source>
             <translation>加载机器人模型配置文件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="345" />
+            <location filename="../../ui/panels/view3d_panel.py" line="341" />
             <source>Robot model profiles (*.json)</source>
             <translation>机器人模型配置文件 (*.json)</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="458" />
+            <location filename="../../ui/panels/view3d_panel.py" line="454" />
             <source>dry run: nothing is sent</source>
             <translation>空运行：不发送任何指令</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="460" />
+            <location filename="../../ui/panels/view3d_panel.py" line="456" />
             <source>no pose: home position shown</source>
             <translation>无位姿：显示原点姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="462" />
+            <location filename="../../ui/panels/view3d_panel.py" line="458" />
             <source>estimate (from the pose, no joint angles)</source>
             <translation>估算（由位姿求得，无关节角）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="464" />
+            <location filename="../../ui/panels/view3d_panel.py" line="460" />
             <source>pose out of the model's reach</source>
             <translation>位姿超出模型可达范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="466" />
+            <location filename="../../ui/panels/view3d_panel.py" line="462" />
             <source>past a joint limit</source>
             <translation>超出关节限位</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="468" />
+            <location filename="../../ui/panels/view3d_panel.py" line="464" />
             <source>stale</source>
             <translation>数据过期</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/view3d_panel.py" line="471" />
+            <location filename="../../ui/panels/view3d_panel.py" line="467" />
             <source>the robot model disagrees with the controller</source>
             <translation>机器人模型与控制器不一致</translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="528" />
+            <location filename="../../ui/panels/view3d_panel.py" line="524" />
             <source>Out of the robot model's reach: %n point(s) (%1)</source>
             <translation>
                 <numerusform>超出机器人模型的可达范围：%n 个点（%1）</numerusform>
             </translation>
         </message>
         <message numerus="yes">
-            <location filename="../../ui/panels/view3d_panel.py" line="536" />
+            <location filename="../../ui/panels/view3d_panel.py" line="532" />
             <source>the path leaves the reach in %n segment(s) (%1)</source>
             <translation>
                 <numerusform>轨迹在 %n 个段中超出可达范围（%1）</numerusform>
