@@ -31,7 +31,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from PySide6.QtCore import QEvent, QModelIndex, QPersistentModelIndex, Signal, Slot
+from PySide6.QtCore import QEvent, QModelIndex, QPersistentModelIndex, QTimer, Signal, Slot
 from PySide6.QtGui import QAction
 from PySide6.QtWidgets import QGroupBox, QLabel, QSizePolicy, QTableView, QVBoxLayout, QWidget
 
@@ -54,7 +54,7 @@ from ui.models.points_model import PointsModel
 from ui.models.segment_model import SegmentTableModel
 from ui.panels.plan_preview import PlanPreview
 from ui.panels.planner_actions import PlannerActions
-from ui.panels.planner_checks import PlannerChecks
+from ui.panels.planner_checks import RECHECK_COALESCE_MS, PlannerChecks, pose_moved
 from ui.panels.planner_edit import PlanEdits, install_point_pickers
 from ui.panels.planner_follow import PlanFollower
 from ui.panels.planner_layout import PlannerLayout
@@ -100,8 +100,13 @@ class PlannerPanel(QWidget):
         self._runner = run_controller or PlanRunController(parent=self, points=points)
         self._sync = point_sync
         self._confirm = confirm or ask_confirmation(self)
-        self._pose_known = False
+        self._checked_pose: Pose | None = None  # the robot's pose the shown checks were made from
         self._alarm_hold = False
+        # A moving arm re-checks at most every RECHECK_COALESCE_MS (poses come at the poll rate).
+        self._recheck_timer = QTimer(self)
+        self._recheck_timer.setSingleShot(True)
+        self._recheck_timer.setInterval(RECHECK_COALESCE_MS)
+        self._recheck_timer.timeout.connect(self._recheck_if_idle)
 
         self.segments = SegmentTableModel(plans.undo_stack, points.ledger, self)
         self.run_flow = PlanRunFlow(self, self._runner, point_sync, points, self)
@@ -132,7 +137,7 @@ class PlannerPanel(QWidget):
         r = self._runner
         r.runningChanged.connect(self._on_running)
         r.pausedChanged.connect(self._update_actions)
-        r.connectedChanged.connect(self._update_actions)
+        r.connectedChanged.connect(self._on_connected)
         r.progressChanged.connect(self._on_progress)
         r.runFinished.connect(self._on_run_finished)
         r.pausedByForeign.connect(self._on_paused_by_foreign)
@@ -333,7 +338,9 @@ class PlannerPanel(QWidget):
 
     # --- checks, estimates, preview
     def _pose(self) -> Pose | None:
-        return self._runner.last_pose
+        """The robot's pose while connected; None while the link is down (the arm may be moved
+        meanwhile: segment 1 is shown from an assumed start, as before the first connection)."""
+        return self._runner.last_pose if self._runner.connected else None
 
     @Slot()
     def set_edit_permission(self, reason: str | None) -> None:
@@ -372,6 +379,7 @@ class PlannerPanel(QWidget):
         """Checks, estimates and preview of the plan on display."""
         plan = self.current_plan()
         self.segments_box.set_plan_name(plan.name if plan is not None else "")
+        self._checked_pose = self._pose()
         self.checks.recheck(plan, self._selected_index())
         self._update_actions()
 
@@ -494,11 +502,26 @@ class PlannerPanel(QWidget):
 
     @Slot(object)
     def _on_pose(self, pose: Pose) -> None:
-        if not self._pose_known:
-            # the first pose: segment 1 now starts at the robot, not at an assumed point
-            self._pose_known = True
-            if not self._runner.running:
-                self.recheck()
+        """The arm moved (a jog, a step, the hand pendant): segment 1 starts somewhere else, so
+        its checks ("the line goes nowhere ... from the current pose") and the estimates are made
+        again (coalesced; not during a run: the run's checks were made from where it started)."""
+        if self._runner.running or self._recheck_timer.isActive():
+            return
+        if self._checked_pose is None or pose_moved(pose, self._checked_pose):
+            self._recheck_timer.start()
+
+    @Slot(bool)
+    def _on_connected(self, connected: bool) -> None:
+        """Connected: the checks start from the robot's pose (its first poll re-checks); the link
+        down: from an assumed start. Either way the estimates are made again."""
+        self._recheck_timer.stop()
+        self._recheck_if_idle()
+        self._update_actions()
+
+    @Slot()
+    def _recheck_if_idle(self) -> None:
+        if not self._runner.running:
+            self.recheck()
 
     def set_alarm_hold(self, hold: bool) -> None:
         """An emergency stop or servo alarm is set (MotionController.alarmHoldChanged)."""
