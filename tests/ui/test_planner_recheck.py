@@ -28,7 +28,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 from tests.ui.test_messages import assert_chinese
 from ui.main_window import TAB_PLANNER, TAB_POINTS, MainWindow
 from ui.messages import issue_line
-from ui.models.segment_model import COL_LENGTH
+from ui.models.plan_columns import COL_LENGTH
 
 pytestmark = [pytest.mark.timeout(120), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
@@ -103,7 +103,12 @@ def test_a_moving_arm_rechecks_a_few_times_a_second_not_at_the_poll_rate(
     panel.select_plan(window.project.plans_model.rowCount() - 1)
     calls: list[int] = []
     real = panel.checks.recheck
-    panel.checks.recheck = lambda *a, **k: (calls.append(1), real(*a, **k))[1]  # type: ignore[method-assign]
+
+    def counted(plan: Any, selected: int | None) -> None:
+        calls.append(1)
+        real(plan, selected)
+
+    panel.checks.recheck = counted  # type: ignore[method-assign]
     poses: list[Any] = []
     window.link.state.poseChanged.connect(poses.append)
     stepper = make_client(sim)
