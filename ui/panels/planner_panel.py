@@ -28,11 +28,12 @@ points).
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
 from PySide6.QtCore import QEvent, QModelIndex, QPersistentModelIndex, QTimer, Signal, Slot
-from PySide6.QtGui import QAction
+from PySide6.QtGui import QAction, QShowEvent
 from PySide6.QtWidgets import QGroupBox, QLabel, QSizePolicy, QTableView, QVBoxLayout, QWidget
 
 from app.models import Pose
@@ -504,8 +505,9 @@ class PlannerPanel(QWidget):
     def _on_pose(self, pose: Pose) -> None:
         """The arm moved (a jog, a step, the hand pendant): segment 1 starts somewhere else, so
         its checks ("the line goes nowhere ... from the current pose") and the estimates are made
-        again (coalesced; not during a run: the run's checks were made from where it started)."""
-        if self._runner.running or self._recheck_timer.isActive():
+        again (coalesced; not during a run: the run's checks were made from where it started;
+        a hidden planner catches up when shown)."""
+        if self._runner.running or self._recheck_timer.isActive() or not self.isVisible():
             return
         if self._checked_pose is None or pose_moved(pose, self._checked_pose):
             self._recheck_timer.start()
@@ -520,7 +522,26 @@ class PlannerPanel(QWidget):
 
     @Slot()
     def _recheck_if_idle(self) -> None:
-        if not self._runner.running:
+        """Re-check unless a run goes on; a long plan spaces the next pose's re-check out to ten
+        times what this one took (a 1,000-segment plan takes ~60 ms: at most ~10 % of the GUI
+        thread while the arm moves)."""
+        if self._runner.running:
+            return
+        started = time.perf_counter()
+        self.recheck()
+        took_ms = (time.perf_counter() - started) * 1000.0
+        self._recheck_timer.setInterval(max(RECHECK_COALESCE_MS, int(10 * took_ms)))
+
+    def _pose_changed_since_check(self) -> bool:
+        pose, checked = self._pose(), self._checked_pose
+        if pose is None or checked is None:
+            return (pose is None) != (checked is None)
+        return pose_moved(pose, checked)
+
+    def showEvent(self, event: QShowEvent) -> None:
+        """Shown again: checks made while the arm moved out of sight are made now."""
+        super().showEvent(event)
+        if not self._runner.running and self._pose_changed_since_check():
             self.recheck()
 
     def set_alarm_hold(self, hold: bool) -> None:
