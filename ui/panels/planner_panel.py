@@ -10,7 +10,9 @@ loop i of m").
 
 Checks (:func:`app.plan.checks.check_plan`, with the robot model's reach once
 :meth:`PlannerPanel.set_reach` gave it), estimates and the preview are recomputed whenever the
-plan, the points or the selection change. Before a run the checks are made again from the
+plan, the points or the selection change, when the arm moves (segment 1 starts at the robot:
+coalesced, a hidden planner catches up when shown) and when the connection changes (the link down:
+segment 1 from an assumed start, the plan's end). Before a run the checks are made again from the
 robot's current pose: errors refuse the run, points that need an upload are offered for upload
 ("1 point needs upload — Upload now?") and the run starts when the upload succeeded.
 
