@@ -334,21 +334,36 @@ def test_step_offsets_show_whole_at_1280x800(make_window: Callable[..., MainWind
                 assert right <= viewport.width(), (touch, frame, axis, right, viewport.width())
 
 
-def test_a_jog_permitted_alarm_clips_no_jog_row_at_1280x800(
-    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow]
+@pytest.mark.parametrize("touch", [False, True], ids=["mouse", "touch"])
+@pytest.mark.parametrize("size", [LAPTOP, (1920, 1080)], ids=["1280x800", "1920x1080"])
+@pytest.mark.parametrize("language", LANGUAGES)
+def test_a_jog_permitted_alarm_clips_no_jog_row(
+    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str, size: Any, touch: bool
 ) -> None:
-    """Issue 21: zh_CN with an alarm that lets the arm jog (the encoder alarm) cut the last jog rows."""
-    window = make_window("zh_CN", LAPTOP)
+    """Issue 21: zh_CN with an alarm that lets the arm jog (the encoder alarm) cut the last jog rows.
+    Both languages, 1280×800 and 1920×1080, mouse and touch mode: every row whole, no scroll bar."""
+    window = make_window(language, size, touch=touch)
     sim.set_alarm(Alarm.ENCODER, True)
     qtbot.waitUntil(window.alarm_banner.isVisible, timeout=SIGNAL_TIMEOUT_MS)
     jog = window.jog_panel
     qtbot.waitUntil(jog.axes_box.isEnabled, timeout=SIGNAL_TIMEOUT_MS)
     window.tabs.setCurrentWidget(jog)
-    for frame, axes in ((TeachFrame.BASE, range(6)), (TeachFrame.JOINT, range(11))):
+    views = (
+        (
+            (TeachFrame.BASE, False, range(6)),
+            (TeachFrame.JOINT, False, range(6)),
+            (TeachFrame.JOINT, True, range(6, 11)),
+        )
+        if touch
+        else ((TeachFrame.BASE, False, range(6)), (TeachFrame.JOINT, False, range(11)))
+    )
+    for frame, external, axes in views:
         jog.set_frame(frame)
+        jog.external_check.setChecked(external)
         settle()
-        assert not jog.axes_scroll.verticalScrollBar().isVisible(), frame
-        assert_rows_whole(jog, axes, MOTION_MIN_HEIGHT)
+        assert not jog.axes_scroll.verticalScrollBar().isVisible(), (frame, external)
+        assert_rows_whole(jog, axes, motion_height(touch))
+    jog.external_check.setChecked(False)
 
 
 @pytest.mark.parametrize("language", LANGUAGES)

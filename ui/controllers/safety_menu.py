@@ -155,7 +155,8 @@ class SafetyMenu(QObject):
         )
         self.audit_action.setText(self.tr("&Audit trail…"))
         self.bundle_action.setText(self.tr("Write a &support bundle…"))
-        QTimer.singleShot(0, self._refresh)  # after the window's own retranslate (it sets tooltips)
+        # after the window's own retranslate (it sets tooltips); dropped with the window (its child)
+        QTimer.singleShot(0, self, self._refresh)
         self._update()
 
     @Slot()

@@ -24,6 +24,14 @@ from ui.models.segment_model import SegmentTableModel
 from ui.panels.plan_preview import PlanPreview
 from ui.panels.planner_widgets import PlanChecksBar
 
+RECHECK_COALESCE_MS = 300  # a moving arm re-checks the plan at most this often
+POSE_MOVED_MM = 0.01  # X Y Z (mm) or A B C (degrees) this far from the checked pose: check again
+
+
+def pose_moved(pose: Pose, checked: Pose) -> bool:
+    """``pose`` is not where the shown checks assumed the robot (segment 1 starts there)."""
+    return any(abs(a - b) > POSE_MOVED_MM for a, b in zip(pose.xyzabc, checked.xyzabc, strict=True))
+
 
 class PlannerChecks:
     """Checks, estimates and preview of the planner's plan (the panel says when)."""

@@ -10,7 +10,9 @@ loop i of m").
 
 Checks (:func:`app.plan.checks.check_plan`, with the robot model's reach once
 :meth:`PlannerPanel.set_reach` gave it), estimates and the preview are recomputed whenever the
-plan, the points or the selection change. Before a run the checks are made again from the
+plan, the points or the selection change, when the arm moves (segment 1 starts at the robot:
+coalesced, a hidden planner catches up when shown) and when the connection changes (the link down:
+segment 1 from an assumed start, the plan's end). Before a run the checks are made again from the
 robot's current pose: errors refuse the run, points that need an upload are offered for upload
 ("1 point needs upload — Upload now?") and the run starts when the upload succeeded.
 
@@ -28,11 +30,12 @@ points).
 
 from __future__ import annotations
 
+import time
 from collections.abc import Callable, Sequence
 from typing import Any
 
-from PySide6.QtCore import QEvent, QModelIndex, QPersistentModelIndex, Signal, Slot
-from PySide6.QtGui import QAction
+from PySide6.QtCore import QEvent, QModelIndex, QPersistentModelIndex, QTimer, Signal, Slot
+from PySide6.QtGui import QAction, QShowEvent
 from PySide6.QtWidgets import QGroupBox, QLabel, QSizePolicy, QTableView, QVBoxLayout, QWidget
 
 from app.models import Pose
@@ -54,7 +57,7 @@ from ui.models.points_model import PointsModel
 from ui.models.segment_model import SegmentTableModel
 from ui.panels.plan_preview import PlanPreview
 from ui.panels.planner_actions import PlannerActions
-from ui.panels.planner_checks import PlannerChecks
+from ui.panels.planner_checks import RECHECK_COALESCE_MS, PlannerChecks, pose_moved
 from ui.panels.planner_edit import PlanEdits, install_point_pickers
 from ui.panels.planner_follow import PlanFollower
 from ui.panels.planner_layout import PlannerLayout
@@ -100,8 +103,13 @@ class PlannerPanel(QWidget):
         self._runner = run_controller or PlanRunController(parent=self, points=points)
         self._sync = point_sync
         self._confirm = confirm or ask_confirmation(self)
-        self._pose_known = False
+        self._checked_pose: Pose | None = None  # the robot's pose the shown checks were made from
         self._alarm_hold = False
+        # A moving arm re-checks at most every RECHECK_COALESCE_MS (poses come at the poll rate).
+        self._recheck_timer = QTimer(self)
+        self._recheck_timer.setSingleShot(True)
+        self._recheck_timer.setInterval(RECHECK_COALESCE_MS)
+        self._recheck_timer.timeout.connect(self._recheck_if_idle)
 
         self.segments = SegmentTableModel(plans.undo_stack, points.ledger, self)
         self.run_flow = PlanRunFlow(self, self._runner, point_sync, points, self)
@@ -132,7 +140,7 @@ class PlannerPanel(QWidget):
         r = self._runner
         r.runningChanged.connect(self._on_running)
         r.pausedChanged.connect(self._update_actions)
-        r.connectedChanged.connect(self._update_actions)
+        r.connectedChanged.connect(self._on_connected)
         r.progressChanged.connect(self._on_progress)
         r.runFinished.connect(self._on_run_finished)
         r.pausedByForeign.connect(self._on_paused_by_foreign)
@@ -333,7 +341,9 @@ class PlannerPanel(QWidget):
 
     # --- checks, estimates, preview
     def _pose(self) -> Pose | None:
-        return self._runner.last_pose
+        """The robot's pose while connected; None while the link is down (the arm may be moved
+        meanwhile: segment 1 is shown from an assumed start, as before the first connection)."""
+        return self._runner.last_pose if self._runner.connected else None
 
     @Slot()
     def set_edit_permission(self, reason: str | None) -> None:
@@ -372,6 +382,7 @@ class PlannerPanel(QWidget):
         """Checks, estimates and preview of the plan on display."""
         plan = self.current_plan()
         self.segments_box.set_plan_name(plan.name if plan is not None else "")
+        self._checked_pose = self._pose()
         self.checks.recheck(plan, self._selected_index())
         self._update_actions()
 
@@ -494,11 +505,46 @@ class PlannerPanel(QWidget):
 
     @Slot(object)
     def _on_pose(self, pose: Pose) -> None:
-        if not self._pose_known:
-            # the first pose: segment 1 now starts at the robot, not at an assumed point
-            self._pose_known = True
-            if not self._runner.running:
-                self.recheck()
+        """The arm moved (a jog, a step, the hand pendant): segment 1 starts somewhere else, so
+        its checks ("the line goes nowhere ... from the current pose") and the estimates are made
+        again (coalesced; not during a run: the run's checks were made from where it started;
+        a hidden planner catches up when shown)."""
+        if self._runner.running or self._recheck_timer.isActive() or not self.isVisible():
+            return
+        if self._checked_pose is None or pose_moved(pose, self._checked_pose):
+            self._recheck_timer.start()
+
+    @Slot(bool)
+    def _on_connected(self, connected: bool) -> None:
+        """Connected: the checks start from the robot's pose (its first poll re-checks); the link
+        down: from an assumed start. Either way the estimates are made again."""
+        self._recheck_timer.stop()
+        self._recheck_if_idle()
+        self._update_actions()
+
+    @Slot()
+    def _recheck_if_idle(self) -> None:
+        """Re-check unless a run goes on; a long plan spaces the next pose's re-check out to ten
+        times what this one took (a 1,000-segment plan takes ~60 ms: at most ~10 % of the GUI
+        thread while the arm moves)."""
+        if self._runner.running:
+            return
+        started = time.perf_counter()
+        self.recheck()
+        took_ms = (time.perf_counter() - started) * 1000.0
+        self._recheck_timer.setInterval(max(RECHECK_COALESCE_MS, int(10 * took_ms)))
+
+    def _pose_changed_since_check(self) -> bool:
+        pose, checked = self._pose(), self._checked_pose
+        if pose is None or checked is None:
+            return (pose is None) != (checked is None)
+        return pose_moved(pose, checked)
+
+    def showEvent(self, event: QShowEvent) -> None:
+        """Shown again: checks made while the arm moved out of sight are made now."""
+        super().showEvent(event)
+        if not self._runner.running and self._pose_changed_since_check():
+            self.recheck()
 
     def set_alarm_hold(self, hold: bool) -> None:
         """An emergency stop or servo alarm is set (MotionController.alarmHoldChanged)."""
