@@ -77,6 +77,10 @@ class MotionWatch:
         self.ack_timeout = timing.ACK_TIMEOUT
         self._last_pose = before_pose
         self.seen = False  # motion (or a running program) was seen: the controller took it
+        self._moved = False  # the pose itself was seen to move (not only a running program state)
+        # go to zero on joints already at zero: a controller may still report its program running for
+        # a moment; with no pose moved it was "already at zero", whichever the polls caught
+        self._zero_at_start = zero_axes is not None and _reads_zero(before_pose, zero_axes)
         self.result: CommandResult | None = None
         self.error: TeachPadError | None = None
         self.note: OutcomeHook | None = None  # the audit's hook (app/link/outcome.py)
@@ -130,6 +134,7 @@ class MotionWatch:
         moved = pose is not None and self._last_pose is not None and pose_moved(pose, self._last_pose)
         if pose is not None:
             self._last_pose = pose
+        self._moved = self._moved or moved
         if not self.seen:
             if running or moved:
                 self.seen = True
@@ -153,9 +158,7 @@ class MotionWatch:
     def _not_started(self, now: float) -> CommandResult:
         seconds = round(self.ack_timeout, 3)
         if self.zero_axes is not None and self._at_zero() is True:
-            return self._end(
-                True, f"{self.text}: done (already at zero)", now, Reason("zero_already", self._args())
-            )
+            return self._already_at_zero(now)
         if self.program is not None:
             text = (
                 f"{self.text} refused: the program did not start within {seconds:g} s (no such "
@@ -179,7 +182,14 @@ class MotionWatch:
                 text = f"{self.text}: the arm stopped before zero ({JOINT_AXIS_NAMES[axis]} at {value:.3f})"
                 params = self._args(axis=JOINT_AXIS_NAMES[axis], value=round(value, 3))
                 return self._fail(CommandStopped(text, code="zero_stopped_short", params=params), now)
+            if self._zero_at_start and not self._moved:
+                return self._already_at_zero(now)
         return self._end(True, f"{self.text}: done", now, Reason("done", self._args()))
+
+    def _already_at_zero(self, now: float) -> CommandResult:
+        return self._end(
+            True, f"{self.text}: done (already at zero)", now, Reason("zero_already", self._args())
+        )
 
     def _at_zero(self) -> bool | None:
         """The joints asked for read zero now (None: the controller does not report them)."""
@@ -279,3 +289,11 @@ class StateCheck:
         text = message or f"{self.text}: {UNKNOWN_ADVICE}" + (f" ({cause})" if cause else "")
         error = OutcomeUnknown(text, params={"operation": self.operation})
         return self._end(False, text, now, reason or error.as_reason(), error)
+
+
+def _reads_zero(pose: Pose | None, axes: tuple[int, ...]) -> bool:
+    """The joints ``axes`` of ``pose`` read zero (False when unknown: no pose, no joints)."""
+    try:
+        return joints_off_zero(pose, axes) is None
+    except LookupError:
+        return False

@@ -73,6 +73,27 @@ def test_go_to_zero_is_done_only_at_zero_when_joints_are_reported(monkeypatch: p
     assert result is not None and result.ok and result.message == "go to zero (J2): done (already at zero)"
 
 
+def test_go_to_zero_already_there_while_the_controller_reports_running_for_a_moment() -> None:
+    """The neighbouring case of "already at zero": a controller (the simulator among them) may report
+    its program running for a poll or two on a go to zero with nothing to do; the pose never moved,
+    so it still reads "already at zero" (it read plain "done" whenever a poll caught that moment)."""
+
+    def joints(j2: float) -> Pose:
+        return Pose(0.0, 0.0, 0.0, 0.0, 0.0, 0.0, joints=(0.0, j2, 0.0, 0.0, 0.0, 0.0))
+
+    watch = MotionWatch(None, "go to zero (J2)", joints(0.0), 0.0, operation="go to zero", zero_axes=(1,))
+    assert watch.update(RUNNING, joints(0.0), 0.05) is None  # taken: running, nothing moved
+    result = watch.update(IDLE, joints(0.0), 0.1)
+    assert result is not None and result.ok and result.message == "go to zero (J2): done (already at zero)"
+    assert result.reason is not None and result.reason.code == "zero_already"
+    # one that moved (from off zero, or away and back) is plain done
+    watch = MotionWatch(None, "go to zero (J2)", joints(0.0), 0.0, operation="go to zero", zero_axes=(1,))
+    assert watch.update(RUNNING, joints(3.0), 0.05) is None
+    assert watch.update(IDLE, joints(0.0), 0.1) is None  # still moving
+    result = watch.update(IDLE, joints(0.0), 0.15)
+    assert result is not None and result.ok and result.message == "go to zero (J2): done"
+
+
 def test_watch_outcome_unknown_and_stopped_reach_its_hook() -> None:
     seen: list[CommandResult] = []
     watch = MotionWatch(RunCommand.RUN_PROGRAM, "run program 1", _pose(0), 0.0, program=1)

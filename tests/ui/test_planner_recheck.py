@@ -11,7 +11,7 @@ from typing import Any
 
 import pytest
 
-from app.link.client import StepFrame
+from app.link.types import StepFrame
 from app.plan.checks import IssueCode
 from app.plan.segments import Plan, Segment
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -27,7 +27,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 )
 from tests.ui.test_messages import assert_chinese
 from ui.main_window import TAB_PLANNER, TAB_POINTS, MainWindow
-from ui.messages import issue_line
+from ui.messages_plan import issue_line
 from ui.models.plan_columns import COL_LENGTH
 
 pytestmark = [pytest.mark.timeout(120), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]

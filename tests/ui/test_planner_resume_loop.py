@@ -10,7 +10,7 @@ from typing import Any
 
 import pytest
 
-from app.link.client import StepFrame
+from app.link.types import StepFrame
 from app.plan.runner import RunEvent, RunProgress, RunState
 from app.plan.segments import Plan, Segment
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures

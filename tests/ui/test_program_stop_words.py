@@ -22,8 +22,8 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 )
 from tests.ui.test_messages import assert_chinese
 from ui.messages import LEVEL_INFO, result_level, result_text
+from ui.palette import COLOR_ERROR
 from ui.panels.status_panel import StatusPanel
-from ui.widgets_common import COLOR_ERROR
 
 pytestmark = pytest.mark.timeout(60)
 
