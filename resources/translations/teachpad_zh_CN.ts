@@ -3762,12 +3762,12 @@
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="352" />
+            <location filename="../../ui/panels/planner_panel.py" line="362" />
             <source>This cell cannot be edited: {why}</source>
             <translation>无法编辑此单元格：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="459" />
+            <location filename="../../ui/panels/planner_panel.py" line="470" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
@@ -5591,57 +5591,57 @@ Remove them all?</source>
             <translation>生成支持包(&amp;S)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="170" />
+            <location filename="../../ui/controllers/safety_menu.py" line="171" />
             <source>Role: {role} · reduced speed</source>
             <translation>角色：{role} · 降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="170" />
+            <location filename="../../ui/controllers/safety_menu.py" line="171" />
             <source>Role: {role}</source>
             <translation>角色：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="180" />
+            <location filename="../../ui/controllers/safety_menu.py" line="181" />
             <source>Cap jog and move speeds (anyone may switch it on)</source>
             <translation>限制点动与移动速度（任何人都可开启）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="193" />
+            <location filename="../../ui/controllers/safety_menu.py" line="194" />
             <source>safety</source>
             <translation>安全</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="256" />
+            <location filename="../../ui/controllers/safety_menu.py" line="257" />
             <source>The register profile could not be saved: {why}</source>
             <translation>寄存器配置无法保存：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="261" />
+            <location filename="../../ui/controllers/safety_menu.py" line="262" />
             <source>Register profile “{name}” saved (revision {rev})</source>
             <translation>寄存器配置“{name}”已保存（第 {rev} 版）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="275" />
+            <location filename="../../ui/controllers/safety_menu.py" line="276" />
             <source>Zip files (*.zip)</source>
             <translation>Zip 文件 (*.zip)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="282" />
+            <location filename="../../ui/controllers/safety_menu.py" line="283" />
             <source>Write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="313" />
+            <location filename="../../ui/controllers/safety_menu.py" line="314" />
             <source>The support bundle could not be written: {why}</source>
             <translation>无法生成支持包：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="316" />
+            <location filename="../../ui/controllers/safety_menu.py" line="317" />
             <source>Support bundle</source>
             <translation>支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="322" />
+            <location filename="../../ui/controllers/safety_menu.py" line="323" />
             <source>Support bundle written: {file} ({n} files)</source>
             <translation>支持包已生成：{file}（{n} 个文件）</translation>
         </message>
