@@ -43,7 +43,7 @@ from app.errors import InvalidInput, LinkError, TeachPadError, WriteBlocked
 from app.link.client import RobotClient
 from app.link.host import WorkerHost
 from app.link.types import Operation
-from app.link.upload_driver import UploadTally, Verdict, batch_end, group_by_tool, send_batch
+from app.link.upload_driver import UploadCounts, Verdict, batch_end, group_by_tool, send_batch
 from app.models import CommandResult
 from app.protocol import registers
 from app.protocol.enums import RunCommand
@@ -74,7 +74,7 @@ class WorkerUpload:
     halts_at_start: int = 0  # the host's count of stops and cancels requested when it began
     #: created, refused (a refused status, a Modbus exception) and failed (no acknowledgement,
     #: timeout, alarm) points, link kept; the first refused or failed point's words
-    tally: UploadTally = field(default_factory=UploadTally)
+    tally: UploadCounts = field(default_factory=UploadCounts)
 
 
 def check_upload_items(client: RobotClient, raw: Sequence[RawItem]) -> list[UploadItem]:

@@ -15,7 +15,7 @@ canary between points):
   failed (:data:`LINK_ERRORS`: the upload ends) or the controller refused its tool frame or status
   read (a Modbus exception: each of its points refused in the controller's words, the upload goes
   on);
-* :func:`verdict` and :class:`UploadTally`: each point's result read one way -- created, the link
+* :func:`verdict` and :class:`UploadCounts`: each point's result read one way -- created, the link
   failed during it (its outcome unknown, the upload ends), stopped by the operator, refused (the
   controller said no), or failed (its result never showed) -- and the refusal tally.
 """
@@ -36,7 +36,7 @@ __all__ = [
     "LINK_ERRORS",
     "REFUSAL_CODES",
     "Batch",
-    "UploadTally",
+    "UploadCounts",
     "Verdict",
     "batch_end",
     "group_by_tool",
@@ -158,7 +158,7 @@ def verdict(result: CommandResult) -> Verdict:
 
 
 @dataclass
-class UploadTally:
+class UploadCounts:
     """The points counted: created, refused, failed; the first refused or failed point's words."""
 
     good: int = 0

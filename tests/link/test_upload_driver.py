@@ -10,7 +10,7 @@ import app.link.upload
 import app.points.upload
 from app.errors import LinkError, ModbusExceptionError, Reason
 from app.link import upload_driver
-from app.link.upload_driver import UploadTally, Verdict, batch_end, send_batch
+from app.link.upload_driver import UploadCounts, Verdict, batch_end, send_batch
 from app.models import CommandResult
 from app.protocol.enums import CommandKind, RunCommand
 
@@ -30,7 +30,7 @@ def _failed(code: str) -> CommandResult:
 
 def test_each_result_reads_one_way_and_is_tallied() -> None:
     done = CommandResult(RunCommand.CREATE_POINT, CommandKind.CREATE_POINT, None, True, "done")
-    tally = UploadTally()
+    tally = UploadCounts()
     seen = [
         tally.count(r)
         for r in (
