@@ -306,7 +306,7 @@ class _Counters(QObject):
         self.traffic_frames = 0
         self.results: list[CommandResult] = []
         self.state = link.connection
-        link.poseChanged.connect(self._on_pose)
+        link.state.poseChanged.connect(self._on_pose)
         link.trafficObserved.connect(self._on_traffic)
         link.commandFinished.connect(self._on_result)
         link.connectionChanged.connect(self._on_connection)

@@ -137,7 +137,7 @@ class Probe(teachpad.MainWindow):
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
         self._bench_started = False
-        self.link.poseChanged.connect(self._bench_pose)
+        self.link.state.poseChanged.connect(self._bench_pose)
         QTimer.singleShot(int(1000 * (soak_s + settle_s + 120)), QApplication.instance().quit)
     def _bench_pose(self, _pose):
         if self._bench_started:

@@ -117,7 +117,7 @@ else:
             mark("window_init_begin")
             super().__init__(*args, **kwargs)
             mark("window_built")
-            self.link.poseChanged.connect(self._bench_pose)  # after the window's own slots
+            self.link.state.poseChanged.connect(self._bench_pose)  # after the window's own slots
             self._bench_filter = ReadoutPaint()
             readout = self.monitor_panel.readouts["X"]
             for widget in (readout, *readout.findChildren(QLabel)):

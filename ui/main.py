@@ -345,7 +345,7 @@ class _Screenshot:
         self.scheduled = False
         self.ok = False
         link.connectionChanged.connect(self._on_connection)
-        link.poseChanged.connect(self._on_pose)
+        link.state.poseChanged.connect(self._on_pose)
         self.timeout = QTimer(window)
         self.timeout.setSingleShot(True)
         self.timeout.timeout.connect(self._give_up)

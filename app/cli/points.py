@@ -41,7 +41,7 @@ from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode, exit_code_for
 from app.cli.points_upload import BootWatch, open_boot, staged_upload
 from app.errors import InvalidInput, ModbusExceptionError, TeachPadError
-from app.link.upload import group_by_tool
+from app.link.upload_driver import group_by_tool
 from app.points.fields import PointLimits, tool_text
 from app.points.ledger import PointLedger
 from app.points.ledger_import import EmptyImport, ImportMode

@@ -5,7 +5,9 @@ tool frame): per point its pose (the first of a batch only), GV200-202 and 440, 
 controller creates it the next point's pose goes into the other pose block -- GV6..GV11, or
 GV12..GV17 when the restart canary (:data:`app.protocol.registers.CANARY_GV`) sits there
 (:func:`app.protocol.registers.stage_gv_for`) -- so the write fills the controller's latency. The
-outcome is an :class:`app.points.upload.UploadReport`, as the point-by-point upload gave.
+outcome is an :class:`app.points.upload.UploadReport`. The sending and the reading of each
+point's result are the one upload driver's (:mod:`app.link.upload_driver`), the GUI's worker's too;
+this module is the CLI's reporting around it (the report, Ctrl-C, the restart canary).
 
 **Restarts** (issue 19): the upload watches the restart canary (:class:`BootWatch`, GV99) the way
 the GUI's link does -- it is read every :data:`CANARY_EVERY` points and after the last. A point
@@ -25,16 +27,15 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
 from typing import Any, Protocol
 
-from app.cli.exit_codes import LINK_ERRORS
 from app.connection import ConnectionSettings
-from app.errors import ModbusExceptionError, TeachPadError
+from app.errors import TeachPadError
 from app.link.types import ControllerIdentity
-from app.link.upload import group_by_tool, refused_before_the_first
+from app.link.upload_driver import Verdict, batch_end, group_by_tool, send_batch, verdict
 from app.models import CommandResult
 from app.points.point import TempPoint
 from app.points.upload import BootLost, UploadOutcome, UploadReport
 from app.points.upload_record import UploadRecord
-from app.protocol.registers import CANARY_GV, UPLOAD_POSE_GV, stage_gv_for
+from app.protocol.registers import CANARY_GV, UPLOAD_POSE_GV
 
 __all__ = ["CANARY_EVERY", "BootWatch", "open_boot", "staged_upload"]
 
@@ -97,7 +98,7 @@ def staged_upload(
     proven: Callable[[list[TempPoint]], object] | None = None,
 ) -> UploadReport:
     """Create ``points`` with ``RobotClient.upload_points``, as the GUI's upload does: in
-    :func:`~app.link.upload.group_by_tool` order (GV245 once per tool), the next point's pose
+    :func:`~app.link.upload_driver.group_by_tool` order (GV245 once per tool), the next point's pose
     staged in the spare pose block (:func:`~app.protocol.registers.stage_gv_for` the restart
     canary's GV) while the controller creates the current one.
 
@@ -126,6 +127,7 @@ class _StagedUpload:
         proven: Callable[[list[TempPoint]], object] | None = None,
     ) -> None:
         self.client, self.ordered, self.progress, self.watch = client, ordered, progress, watch
+        self.tools = [p.tool for p in ordered]
         self.on_proven = proven
         self.results: list[CommandResult] = []  # the batch under way's results so far ...
         self.batch_first = 0  # ... and the index of its first point
@@ -192,9 +194,7 @@ class _StagedUpload:
         ordered, total = self.ordered, self.total
         while self.done < total:
             done = self.done
-            end = done
-            while end < total and ordered[end].tool == ordered[done].tool:
-                end += 1
+            end = batch_end(self.tools, done)
             if not self.tell(done):
                 return self.stop_here(self.why_stopped())
             stopped = self.batch(ordered[done:end])
@@ -219,22 +219,20 @@ class _StagedUpload:
         self.results, self.batch_first = results, first
         report = self.report
         try:
-            self.client.upload_points(
+            sent = send_batch(
+                self.client,
                 [(p.id, p.xyzabc) for p in batch],
                 batch[0].tool,
-                lambda n, _total, first=first: self.tell(first + n),
-                gv_start=UPLOAD_POSE_GV,
-                stage_gv=stage_gv_for(CANARY_GV),
+                lambda n, _total: self.tell(first + n),
+                canary_gv=CANARY_GV,
                 results=results,
             )
-        except LINK_ERRORS as exc:  # before its first point (the status read): nothing of it done
-            return self.stop_here(str(exc) or type(exc).__name__)
-        except ModbusExceptionError as exc:  # refused before its first point (GV245, the status read)
-            results.extend(refused_before_the_first((p.id for p in batch[len(results) :]), exc))
         except KeyboardInterrupt:  # keep what was done: the caller records it, the ledger stays true
             _record(report, batch, results)
             self.done += len(results)
             return self.stop_here("interrupted", interrupted=True)
+        if sent.link_error is not None:  # before its first point (the status read): nothing of it done
+            return self.stop_here(sent.link_error)
         link_lost = _record(report, batch, results)
         if link_lost is not None:
             self.done += len(results) - 1  # that point's outcome is unknown: not attempted
@@ -281,9 +279,10 @@ def _record(report: UploadReport, batch: Sequence[TempPoint], results: Sequence[
     failure, the link is fine and the upload goes on."""
     for point, result in zip(batch, results, strict=False):
         reason = (result.message or "").removeprefix(f"point {point.id}: ")
-        if result.ok:
+        seen = verdict(result)
+        if seen is Verdict.CREATED:
             report.outcomes.append(UploadOutcome(point.id, True, sent=point, unconfirmed=result.unconfirmed))
-        elif result.link_failed:  # the one rule (CommandResult.link_failed), as the GUI's upload
+        elif seen is Verdict.LINK_FAILED:  # the one rule (CommandResult.link_failed), as the GUI's upload
             return reason or "the link failed"
         else:
             report.outcomes.append(UploadOutcome(point.id, False, reason or "failed"))

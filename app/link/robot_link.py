@@ -33,7 +33,7 @@ from app.link.ops import LinkOp, Stop
 from app.link.state import DEFAULT_FRESHNESS_LIMIT, PollUpdate, RobotState
 from app.link.stats import LinkStats
 from app.link.types import ConnectionState, LinkState, WorkerError
-from app.models import CommandResult, ControllerStatus, Pose
+from app.models import CommandResult, ControllerStatus
 
 if TYPE_CHECKING:  # the worker (pymodbus, the envelope's numpy) is imported by the first request
     from app.link.worker import RobotWorker
@@ -55,7 +55,6 @@ GIL_SWITCH_INTERVAL = 0.0005
 class RobotLink(QObject):
     """Owns the worker thread; plain methods that never block on the network (except shutdown)."""
 
-    poseChanged = Signal(Pose)  # noqa: N815
     statusChanged = Signal(ControllerStatus)  # noqa: N815
     alarmsChanged = Signal(int)  # noqa: N815
     connectionChanged = Signal(ConnectionState)  # noqa: N815
@@ -220,8 +219,7 @@ class RobotLink(QObject):
         state = self._state
         pose, status, alarms = update.pose, update.status, update.alarms
         if pose is not None:
-            state.set_pose(pose)
-            self.poseChanged.emit(pose)
+            state.set_pose(pose)  # its poseChanged is the pose's one signal (views connect there)
         if status is not None:
             state.set_status(status)
             self.statusChanged.emit(status)

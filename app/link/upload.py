@@ -24,6 +24,10 @@ refused (a refused status, or a Modbus exception, which ends that call of ``uplo
 whose result never showed (no acknowledgement, a timeout, an alarm), is reported failed in its own
 words and counted as refused or failed; the next chunk goes on with the next point (the CLI's
 ``points upload`` follows the same rule).
+
+The per-batch sending and the reading of each point's result are the one upload driver's
+(:mod:`app.link.upload_driver`), shared with the CLI; this module is the worker's reporting around
+it (chunks, urgent jobs between points, ``pointUploaded``, ``uploadProgress``, the final result).
 """
 
 from __future__ import annotations
@@ -31,41 +35,30 @@ from __future__ import annotations
 import functools
 import math
 import time
-from collections.abc import Callable, Iterable, Sequence
-from dataclasses import dataclass
-from typing import TypeVar
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
 
 from app import timing
-from app.errors import (
-    InvalidInput,
-    LinkError,
-    ModbusExceptionError,
-    ResponseTimeout,
-    TeachPadError,
-    WriteBlocked,
-)
+from app.errors import InvalidInput, LinkError, TeachPadError, WriteBlocked
 from app.link.client import RobotClient
 from app.link.host import WorkerHost
 from app.link.types import Operation
+from app.link.upload_driver import UploadCounts, Verdict, batch_end, group_by_tool, send_batch
 from app.models import CommandResult
 from app.protocol import registers
-from app.protocol.enums import CommandKind, RunCommand
-from app.protocol.registers import UPLOAD_POSE_GV, stage_gv_for
+from app.protocol.enums import RunCommand
 
 __all__ = [
     "UploadItem",
     "Uploader",
     "WorkerUpload",
     "check_upload_items",
-    "group_by_tool",
-    "refused_before_the_first",
 ]
 
 _FLOAT32_MAX = 3.4028234663852886e38
 
 UploadItem = tuple[int, tuple[float, ...], int]  # (point id, pose X Y Z A B C, tool frame)
 RawItem = tuple[object, tuple[object, ...], object]
-T = TypeVar("T")
 
 
 @dataclass
@@ -75,45 +68,13 @@ class WorkerUpload:
     request_id: int | None
     items: list[UploadItem]  # grouped by tool frame: GV245 is written once per group
     index: int = 0  # items attempted so far
-    good: int = 0
     end: str | None = None  # why it ends early ("cancelled", "stopped", "link lost: ..."), once set
     progress_at: float = 0.0  # when uploadProgress was last emitted
     progress_done: int = -1  # the ``done`` it carried
     halts_at_start: int = 0  # the host's count of stops and cancels requested when it began
-    refused: int = 0  # points the controller refused (a refused status, a Modbus exception): link kept
-    failed: int = 0  # points whose result never showed (no acknowledgement, timeout, alarm): link kept
-    first_failure: str = ""  # the first refused or failed point's words, for the final result
-
-
-def group_by_tool(items: Iterable[T], tool: Callable[[T], int]) -> list[T]:
-    """The order points are uploaded in (GV245 is written once per tool frame), the GUI's and the
-    CLI's: grouped by ``tool(item)``, stable -- the tools in order of first appearance, each tool's
-    points in input order."""
-    groups: dict[int, list[T]] = {}
-    for item in items:
-        groups.setdefault(tool(item), []).append(item)
-    return [item for group in groups.values() for item in group]
-
-
-REFUSAL_CODES = frozenset({"command_refused", "modbus_exception"})  # the controller answered no
-
-
-def refused_before_the_first(point_ids: Iterable[int], exc: ModbusExceptionError) -> list[CommandResult]:
-    """A batch the controller refused before its first point (a Modbus exception on its tool frame
-    GV245 or its status read): every point of it refused in the controller's words -- not a link
-    failure (:attr:`CommandResult.link_failed` is False), the upload goes on with the next batch."""
-    return [
-        CommandResult(
-            RunCommand.CREATE_POINT,
-            CommandKind.CREATE_POINT,
-            None,
-            False,
-            str(exc),
-            {"point_id": float(pid)},
-            reason=exc.as_reason(),
-        )
-        for pid in point_ids
-    ]
+    #: created, refused (a refused status, a Modbus exception) and failed (no acknowledgement,
+    #: timeout, alarm) points, link kept; the first refused or failed point's words
+    tally: UploadCounts = field(default_factory=UploadCounts)
 
 
 def check_upload_items(client: RobotClient, raw: Sequence[RawItem]) -> list[UploadItem]:
@@ -141,30 +102,6 @@ def check_upload_items(client: RobotClient, raw: Sequence[RawItem]) -> list[Uplo
             values.append(float(v))
         items.append((pid, tuple(values), tool))
     return items
-
-
-def _chunk_end(items: Sequence[UploadItem], first: int) -> int:
-    """Where the chunk that begins at ``first`` ends: at most :data:`app.timing.UPLOAD_CHUNK_POINTS`
-    points, all of one tool."""
-    tool = items[first][2]
-    last = first
-    while last < len(items) and last - first < timing.UPLOAD_CHUNK_POINTS and items[last][2] == tool:
-        last += 1
-    return last
-
-
-def _count_failure(upload: WorkerUpload, result: CommandResult) -> None:
-    """A point that failed on a sound link: the next chunk goes on with the next point in a
-    fresh call (its pose written anew, whatever was staged before). Refused only when the
-    controller said no (a refused status, a Modbus exception, which ended the batch there); a
-    point whose result never showed (no acknowledgement, a timeout, an alarm) failed, its words
-    say how."""
-    code = result.reason.code if result.reason is not None else ""
-    if code in REFUSAL_CODES:
-        upload.refused += 1
-    else:
-        upload.failed += 1
-    upload.first_failure = upload.first_failure or result.message
 
 
 class Uploader:
@@ -229,7 +166,7 @@ class Uploader:
         client = host.client_or_raise()
         start = time.monotonic()
         first = upload.index
-        last = _chunk_end(upload.items, first)
+        last = batch_end([tool for _, _, tool in upload.items], first, timing.UPLOAD_CHUNK_POINTS)
         results, transport_error = self._send_chunk(client, upload, upload.items[first:last], start)
         transport_error = self._tally(upload, first, results, transport_error)
         if transport_error is not None:
@@ -244,33 +181,25 @@ class Uploader:
         """One call of ``upload_points`` for ``items`` (one tool), under the upload's request id:
         its results, and the link's failure before the first point (None: none)."""
         host = self._host
-        tool = items[0][2]
-        transport_error: str | None = None
         self._busy = True
         outer_id, host.request_id = host.request_id, upload.request_id
         try:
-            chunk = [(pid, pose) for pid, pose, _ in items]
-            stage_gv = stage_gv_for(host.supervisor.canary_gv)
-            results = client.upload_points(
-                chunk,
-                tool,
+            batch = send_batch(
+                client,
+                [(pid, pose) for pid, pose, _ in items],
+                items[0][2],
                 functools.partial(self._between_points, upload, start),
-                gv_start=UPLOAD_POSE_GV,
-                stage_gv=stage_gv,
+                canary_gv=host.supervisor.canary_gv,
                 halted=functools.partial(self._halted, upload),  # no staging write, no next point
                 between=self._between_reads,
             )
-        except (LinkError, ResponseTimeout) as exc:  # before the first point (status read, mode)
-            results, transport_error = [], str(exc)
-        except ModbusExceptionError as exc:  # refused before the first point (tool frame, status read)
-            results = refused_before_the_first((pid for pid, _ in chunk), exc)
         except TeachPadError as exc:
-            results = []
             upload.end = upload.end or str(exc)
+            return [], None
         finally:
             self._busy = False
             host.request_id = outer_id
-        return results, transport_error
+        return batch.results, batch.link_error
 
     def _between_points(self, upload: WorkerUpload, start: float, done: int, total: int) -> bool:
         """``upload_points``'s progress: the urgent jobs and a due poll run between two points;
@@ -298,15 +227,13 @@ class Uploader:
         host = self._host
         for (point_id, _, _), result in zip(upload.items[first:], results, strict=False):
             upload.index += 1
-            if result.ok:
-                upload.good += 1
+            seen = upload.tally.count(result)
+            if seen is Verdict.CREATED:
                 host.publish_point_uploaded(point_id, True, "", result.unconfirmed)
                 continue
             host.publish_point_uploaded(point_id, False, result.message or "failed")
-            if result.link_failed:  # its outcome is unknown, the link not to be trusted
+            if seen is Verdict.LINK_FAILED:  # its outcome is unknown, the link not to be trusted
                 transport_error = result.message
-            elif not result.stopped_by_operator:
-                _count_failure(upload, result)
         return transport_error
 
     def _halted(self, upload: WorkerUpload) -> bool:
@@ -336,24 +263,24 @@ class Uploader:
         upload, self.run = self.run, None
         if upload is None:
             return
-        total = len(upload.items)
+        total, tally = len(upload.items), upload.tally
         self._note_progress(upload, force=True)
-        text = f"uploaded {upload.good} of {total} points"
-        if upload.refused:
-            text += f", {upload.refused} refused"
-        if upload.failed:
-            text += f", {upload.failed} failed"
-        if upload.first_failure and upload.end is None and upload.index >= total:
+        text = f"uploaded {tally.good} of {total} points"
+        if tally.refused:
+            text += f", {tally.refused} refused"
+        if tally.failed:
+            text += f", {tally.failed} failed"
+        if tally.first_failure and upload.end is None and upload.index >= total:
             # the first failure's words only when every point was tried: one that ended early
             # keeps its "(why)" last, where the GUI reads it (ui/controllers point_sync_state)
-            text += f": {upload.first_failure}"
+            text += f": {tally.first_failure}"
         text += f" ({upload.end})" if upload.end else ""
         details = {
-            "uploaded": float(upload.good),
+            "uploaded": float(tally.good),
             "attempted": float(upload.index),
-            "refused": float(upload.refused),
-            "failed": float(upload.failed),
+            "refused": float(tally.refused),
+            "failed": float(tally.failed),
             "total": float(total),
         }
-        result = CommandResult(RunCommand.CREATE_POINT, None, None, upload.good == total, text, details)
+        result = CommandResult(RunCommand.CREATE_POINT, None, None, tally.good == total, text, details)
         self._host.emit_result(result, upload.request_id)

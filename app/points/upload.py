@@ -1,25 +1,18 @@
-"""Uploading temp points to the controller (function 2), and the id lists of the CLI."""
+"""An upload's report (what the controller created, refused, or was not asked), how it updates the
+ledger, and the id lists of the CLI. The upload itself is the one upload driver's
+(:mod:`app.link.upload_driver`): the GUI's worker (:mod:`app.link.upload`) and the CLI
+(:func:`app.cli.points_upload.staged_upload`, which builds this report) send through it."""
 
 from __future__ import annotations
 
-from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING
 
-from app.errors import InvalidInput, LinkError, MalformedResponse, ResponseTimeout, TeachPadError
-from app.models import CommandResult
+from app.errors import InvalidInput
 from app.points.point import SyncState, TempPoint
 
 if TYPE_CHECKING:
     from app.points.ledger import PointLedger
-
-
-class PointUploader(Protocol):
-    """The part of ``RobotClient`` an upload needs (duck-typed)."""
-
-    def create_point(
-        self, point_id: int, *, pose: Sequence[float] | None = ..., tool: int = ..., wait: bool = ...
-    ) -> CommandResult: ...
 
 
 @dataclass(frozen=True)
@@ -75,51 +68,6 @@ class UploadReport:
     @property
     def all_ok(self) -> bool:
         return self.aborted is None and not self.failed
-
-
-def upload_points(
-    client: PointUploader,
-    points: Sequence[TempPoint],
-    *,
-    progress: Callable[[int, int], bool | None] | None = None,
-) -> UploadReport:
-    """Create ``points`` on the controller one by one (function 2 from GVs).
-
-    A point the controller refuses is recorded and the upload goes on; a lost link, Ctrl-C
-    or ``progress`` returning False ends it, leaving the rest (the interrupted point included)
-    in ``not_attempted``. Does not touch a ledger: apply the report with :func:`apply_upload`
-    in the ledger's thread.
-    """
-    report = UploadReport()
-    total = len(points)
-    for done, point in enumerate(points):
-        if progress is not None and progress(done, total) is False:
-            report.aborted = "stopped on request"
-            report.not_attempted = [p.id for p in points[done:]]
-            return report
-        try:
-            result = client.create_point(point.id, pose=point.xyzabc, tool=point.tool, wait=True)
-        except (LinkError, ResponseTimeout, MalformedResponse) as exc:  # the link was closed
-            report.aborted = str(exc) or type(exc).__name__
-            report.not_attempted = [p.id for p in points[done:]]
-            return report
-        except KeyboardInterrupt:
-            # Keep what was done: the caller records it and the ledger stays truthful.
-            report.aborted = "interrupted"
-            report.interrupted = True
-            report.not_attempted = [p.id for p in points[done:]]
-            return report
-        except TeachPadError as exc:
-            report.outcomes.append(UploadOutcome(point.id, False, str(exc) or type(exc).__name__))
-            continue
-        if result.ok:
-            report.outcomes.append(UploadOutcome(point.id, True, sent=point, unconfirmed=result.unconfirmed))
-        else:
-            reason = result.message or (result.status.text if result.status else "failed")
-            report.outcomes.append(UploadOutcome(point.id, False, reason))
-    if progress is not None:
-        progress(total, total)
-    return report
 
 
 def apply_upload(ledger: PointLedger, report: UploadReport) -> list[int]:

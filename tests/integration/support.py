@@ -14,10 +14,11 @@ from typing import Any
 
 import numpy as np
 
+from app.cli.points_upload import staged_upload
 from app.link.client import RobotClient
 from app.points.ledger import PointLedger
 from app.points.point import make_point
-from app.points.upload import apply_upload, upload_points
+from app.points.upload import apply_upload
 from app.protocol import registers
 from app.protocol.enums import RunCommand
 
@@ -109,7 +110,7 @@ LINE_POINTS = {1: P1, 2: P2, 3: P3}
 
 def restore(client: RobotClient, ledger: PointLedger) -> None:
     """'Restore all': create every point the controller may not hold, record the outcome."""
-    report = upload_points(client, ledger.needing_upload())
+    report = staged_upload(client, ledger.needing_upload())
     assert report.all_ok, (report.aborted, report.failed)
     apply_upload(ledger, report)
     assert not ledger.needing_upload()

@@ -1,6 +1,6 @@
 """The whole teach -> ledger -> restore -> run workflow against the real simulator over TCP.
 
-Each test drives the product's own pieces (RobotClient, PointLedger, upload_points /
+Each test drives the product's own pieces (RobotClient, PointLedger, staged_upload /
 apply_upload, check_plan, PlanRunner) the way the GUI worker or the CLI does, and checks the
 result on the simulated controller itself (``sim.state()``, ``sim.trajectory()``,
 ``sim.writes``). Speeds are high and distances short so the file runs in a few seconds.

@@ -27,7 +27,8 @@ from app.errors import (
 from app.link.jobs import Job, JobQueue
 from app.link.ops import CancelUpload, JogRelease, Stop, UploadPoints
 from app.link.types import LinkState
-from app.link.upload import RawItem, Uploader, check_upload_items, group_by_tool
+from app.link.upload import RawItem, Uploader, check_upload_items
+from app.link.upload_driver import group_by_tool
 from app.models import LINK_FAILURE_CODES, CommandResult
 from app.protocol import registers
 from app.protocol.enums import CommandKind, CommandStatus, RunCommand

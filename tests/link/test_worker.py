@@ -60,7 +60,7 @@ def _result(predicate: Any) -> Any:
 def test_connect_poll_disconnect(qtbot: Any, sim: Any, link: RobotLink) -> None:
     states: list[LinkState] = []
     link.connectionChanged.connect(lambda s: states.append(s.state))
-    with qtbot.waitSignals([link.poseChanged, link.statusChanged], timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignals([link.state.poseChanged, link.statusChanged], timeout=SIGNAL_TIMEOUT_MS):
         connect(qtbot, link, sim, timeout=2.0)  # roomy: the first attempt must succeed on a loaded box
     assert states[:2] == [LinkState.CONNECTING, LinkState.CONNECTED]
     assert link.connection.endpoint == f"127.0.0.1:{sim.port}"
@@ -73,10 +73,10 @@ def test_connect_poll_disconnect(qtbot: Any, sim: Any, link: RobotLink) -> None:
 
 
 def test_signals_only_on_change(qtbot: Any, sim: Any, link: RobotLink) -> None:
-    with qtbot.waitSignal(link.poseChanged, timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(link.state.poseChanged, timeout=SIGNAL_TIMEOUT_MS):
         connect(qtbot, link, sim)
     # The arm stands still: dozens of polls, no new pose.
-    with qtbot.assertNotEmitted(link.poseChanged, wait=300):
+    with qtbot.assertNotEmitted(link.state.poseChanged, wait=300):
         pass
     refs_before = sys.getrefcount(True)
     with qtbot.waitSignal(
@@ -90,7 +90,7 @@ def test_live_pose_while_the_simulator_moves(qtbot: Any, sim: Any, link: RobotLi
     """The pose published before ``commandFinished`` is the final one: a poll reads the status
     first and the pose after it, and the result goes out after that poll's pose."""
     poses: list[Pose] = []
-    link.poseChanged.connect(poses.append)
+    link.state.poseChanged.connect(poses.append)
     connect(qtbot, link, sim)
     start = sim.state().joints[0]
     with qtbot.waitSignal(

@@ -6,16 +6,14 @@ import math
 
 import pytest
 
-from app.errors import CommandRefused, InvalidInput, LinkError
+from app.errors import InvalidInput
 from app.models import Pose
 from app.points.fields import FieldError, PointLimits
 from app.points.ledger import PointLedger
 from app.points.ledger_import import ImportMode
 from app.points.point import SyncState, make_point, point_from_pose
-from app.points.upload import apply_upload, parse_id_list, upload_points
-from app.protocol.enums import CommandKind, CommandStatus
+from app.points.upload import parse_id_list
 from app.protocol.registers import TOOL_NONE
-from tests.fakes import FakeClient
 
 ON = SyncState.ON_CONTROLLER
 
@@ -246,40 +244,3 @@ def test_parse_id_list() -> None:
     for bad in ("a", "5-1", "1-", "1;2"):
         with pytest.raises(InvalidInput):
             parse_id_list(bad)
-
-
-def test_upload_records_refusals_and_stops_on_lost_link() -> None:
-    ledger = ledger3()
-    refused = CommandRefused(CommandStatus(CommandKind.CREATE_POINT, 1))
-    client = FakeClient(create_script={1: refused, 2: LinkError("connection lost")})
-    report = upload_points(client, [*ledger.snapshot(), make_point(7)])
-    assert [c["id"] for c in client.creates] == [1, 2, 5]
-    assert client.creates[0]["pose"] == (400, 0, 450, 180, 0, 0) and client.creates[2]["tool"] == 0
-    assert report.ok_count == 1 and [o.point_id for o in report.failed] == [2]
-    assert "bad point id" in report.failed[0].reason
-    assert report.aborted == "connection lost" and report.not_attempted == [5, 7]
-    assert not report.all_ok
-
-    ledger.set_field(0, "x", 1)  # edited while uploading: becomes CHANGED, upload must not hide that
-    ledger.set_sync(2, ON)  # by id
-    rows = apply_upload(ledger, report)
-    assert rows == [1]
-    assert ledger[0].sync is SyncState.CHANGED
-    assert ledger[1].sync is SyncState.FAILED and "bad point id" in ledger[1].sync_error
-    assert ledger[2].sync is SyncState.CHANGED
-
-
-def test_upload_progress_can_stop_and_all_ok() -> None:
-    ledger = ledger3()
-    seen: list[tuple[int, int]] = []
-
-    def progress(done: int, total: int) -> bool:
-        seen.append((done, total))
-        return done < 2
-
-    report = upload_points(FakeClient(), ledger.snapshot(), progress=progress)
-    assert seen == [(0, 3), (1, 3), (2, 3)] and report.ok_count == 2 and report.not_attempted == [5]
-    report = upload_points(FakeClient(), ledger.snapshot())
-    assert report.all_ok
-    apply_upload(ledger, report)
-    assert all(p.sync is ON for p in ledger)

@@ -87,7 +87,7 @@ class PlanRunController(QObject):
     (:class:`RunProgress`, every segment start / end), ``segmentStarted(int, int)`` (0-based
     index, 1-based loop), ``runFinished(object)`` (:class:`RunOutcome`), ``connectedChanged(bool)``
     (``link.state.connected``, at each connection change of the state),
-    ``poseChanged(object)`` (the link's pose, forwarded for the preview), ``pointsMissing(object)``
+    ``pointsMissing(object)``
     (list of point ids: the controller answered "bad end point id", so it does not hold the
     segment's points — e.g. it restarted without the link noticing), ``segmentPrepared(int,
     object)`` (index, list of point ids re-created: the guarded move goes out next),
@@ -103,7 +103,6 @@ class PlanRunController(QObject):
     segmentStarted = Signal(int, int)
     runFinished = Signal(object)
     connectedChanged = Signal(bool)
-    poseChanged = Signal(object)
     pointsMissing = Signal(object)
     segmentPrepared = Signal(int, object)
     pointMismatch = Signal(int)
@@ -144,7 +143,6 @@ class PlanRunController(QObject):
             raise RuntimeError("the link is already set")
         self._link = link
         link.state.connectionChanged.connect(self._on_connection)
-        link.state.poseChanged.connect(self.poseChanged)
         link.pointUploaded.connect(self._on_point_uploaded)
         link.foreignMaster.connect(self._on_foreign_master)
 

@@ -145,8 +145,9 @@ class PlannerPanel(QWidget):
         r.runFinished.connect(self._on_run_finished)
         r.pausedByForeign.connect(self._on_paused_by_foreign)
         r.resumeRefused.connect(self._on_resume_refused)
-        r.poseChanged.connect(self.preview.on_pose)
-        r.poseChanged.connect(self._on_pose)
+        if r.link is not None:  # the pose's one signal, the link's picture of the robot
+            r.link.state.poseChanged.connect(self.preview.on_pose)
+            r.link.state.poseChanged.connect(self._on_pose)
         if point_sync is not None:
             r.pointsMissing.connect(point_sync.points_missing)
             point_sync.busyChanged.connect(self._update_actions)

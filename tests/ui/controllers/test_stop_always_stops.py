@@ -82,7 +82,7 @@ def _disconnect(qtbot: Any, window: Any) -> None:
 
 def _a_new_poll(qtbot: Any, window: Any) -> None:
     """The worker went on polling (what was queued before has run)."""
-    with qtbot.waitSignal(window.link.poseChanged, timeout=SIGNAL_TIMEOUT_MS):
+    with qtbot.waitSignal(window.link.state.poseChanged, timeout=SIGNAL_TIMEOUT_MS):
         pass
 
 
