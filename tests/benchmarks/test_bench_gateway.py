@@ -49,7 +49,8 @@ def test_the_gateway_suite_quick_run_prints_its_keys_beside_their_goals() -> Non
         value = _lookup(out, key)
         assert isinstance(value, int | float) and value > 0, (key, value)
     assert _lookup(out, "gateway.gateway_64.messages.DDATA") > 0
-    assert _lookup(out, "gateway.dead_one_of_16.one_dead.dead_controller_answers") == 0
+    # stopped: at most the one answer that was under way when it stopped
+    assert _lookup(out, "gateway.dead_one_of_16.one_dead.dead_controller_answers") <= 1
     assert _lookup(out, "gateway.bare_64.poll_period.p99_ms") is not None
     assert _lookup(out, "gateway.simulators.one_process.cpu_pct_per_controller") is not None
     entries = {e["key"]: e for e in out["goals"]["entries"]}
