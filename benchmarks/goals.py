@@ -90,6 +90,62 @@ GOALS: tuple[tuple[str, float | None, str, str], ...] = (
     ("gui.memory.soak.growth_mb", 10.0, " MB", "RSS growth over the soak (10 minutes with --long)"),
     ("gui.memory.idle_rss_mb", None, " MB", "idle RSS of the GUI process after start-up (report only)"),
     ("core.monitor_cycle.ratio_robot_vs_bare", None, "x", "monitor cycle vs bare pymodbus (report only)"),
+    # issue 23: the gateway at scale (benchmarks.gateway; --quick: 16 controllers, short windows)
+    (
+        "gateway.gateway_64.cpu_pct_of_one_core",
+        50.0,
+        " %",
+        "gateway CPU, 64 controllers at 10 Hz to mosquitto",
+    ),
+    (
+        "gateway.gateway_64.poll_period_p99_vs_period",
+        1.5,
+        "x",
+        "gateway poll period p99 vs the period (64 controllers at 10 Hz)",
+    ),
+    (
+        "gateway.gateway_64.answer_to_subscriber.p99_ms",
+        50.0,
+        " ms",
+        "poll answer -> independent MQTT subscriber, p99",
+    ),
+    (
+        "gateway.dead_one_of_16.others_p99_dead_vs_alive",
+        1.1,
+        "x",
+        "one dead of 16: the others' poll period p99 vs all alive",
+    ),
+    (
+        "gateway.gateway_vs_bare.period_p99_ratio",
+        None,
+        "x",
+        "gateway poll period p99 vs a bare pymodbus loop (report only)",
+    ),
+    ("gateway.gateway_vs_bare.cpu_ratio", None, "x", "gateway CPU vs a bare pymodbus loop (report only)"),
+    (
+        "gateway.simulators.one_process.cpu_pct_per_controller",
+        None,
+        " %",
+        "simulator CPU per controller, 16 in one process (report only)",
+    ),
+    (
+        "gateway.simulators.one_process_each.cpu_pct_per_controller",
+        None,
+        " %",
+        "simulator CPU per controller, one process each (report only)",
+    ),
+    (
+        "gateway.simulators.one_process.answer.p99_ms",
+        None,
+        " ms",
+        "simulator answer p99, 16 in one process (report only)",
+    ),
+    (
+        "gateway.simulators.one_process_each.answer.p99_ms",
+        None,
+        " ms",
+        "simulator answer p99, one process each (report only)",
+    ),
     ("bundle.size_mb", None, " MB", "the bundle (make dist) on disk (report only)"),
     ("bundle.cli_status_s.ratio_bundle_vs_venv", None, "x", "CLI status run: bundle vs venv (report only)"),
 )

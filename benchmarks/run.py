@@ -1,9 +1,11 @@
 """`make bench`: run every benchmark and print one JSON object.
 
-Usage: python -m benchmarks.run [--quick] [--long] [--only core,gui,points,noisy_line,bundle]
+Usage: python -m benchmarks.run [--quick] [--long] [--only core,gui,points,noisy_line,bundle,gateway]
 
 ``goals`` (:mod:`benchmarks.goals`) prints each of the issue's figures beside its goal.
 ``--long`` adds the 10-minute memory soak (``gui.memory.soak``).
+``gateway`` (:mod:`benchmarks.gateway`): the Sparkplug gateway with 64 simulated controllers at
+10 Hz through a real mosquitto, one dead controller of 16, a bare pymodbus loop beside it.
 ``bundle`` (:mod:`benchmarks.bundle`): the size and start-up of ``make dist``'s bundle beside the
 venv's; null figures with the reason when it is not built.
 
@@ -73,6 +75,13 @@ def _safety(args: argparse.Namespace) -> dict[str, Any]:
     return guarded("safety", lambda: safety.run(args.quick))
 
 
+def _gateway(args: argparse.Namespace) -> dict[str, Any]:
+    """The gateway at scale (issue 23): 64 controllers at 10 Hz to a real mosquitto, one dead of 16,
+    a bare pymodbus loop beside it, the simulator in one process against many."""
+    gateway = __import__("benchmarks.gateway", fromlist=["run"])
+    return guarded("gateway", lambda: gateway.run(args.quick))
+
+
 #: The suites in the order they run; each imported only when it runs.
 SUITES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
     "core": _core,
@@ -81,6 +90,7 @@ SUITES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
     "noisy_line": _noisy_line,
     "bundle": _bundle,
     "safety": _safety,
+    "gateway": _gateway,
 }
 
 
@@ -88,7 +98,9 @@ def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--quick", action="store_true", help="small N and short windows")
     parser.add_argument("--long", action="store_true", help="memory soak of 10 minutes (RSS every 30 s)")
-    parser.add_argument("--only", default="core,gui,points,noisy_line,bundle", help="comma-separated suites")
+    parser.add_argument(
+        "--only", default="core,gui,points,noisy_line,bundle,gateway", help="comma-separated suites"
+    )
     parser.add_argument(
         "--no-compile",
         action="store_true",

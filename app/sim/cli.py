@@ -17,11 +17,14 @@ from pymodbus.constants import ExcCodes
 from app.protocol.codec import WordOrder
 from app.protocol.enums import Alarm
 from app.sim.config import GV291_MODES, TIMING_PROFILES, SimConfig
+from app.sim.fleet import SimFleet
 from app.sim.guard import WATCHDOG_TIMEOUT
 from app.sim.server import SimController
 from app.version import VersionAction
 
 log = logging.getLogger(__name__)
+
+MAX_CONTROLLERS = 256
 
 ALARM_NAMES: dict[str, Alarm] = {
     "estop": Alarm.ESTOP,
@@ -119,6 +122,18 @@ def build_parser() -> argparse.ArgumentParser:
     serial.add_argument("--baud", type=int, default=115200, help="baud rate (default 115200)")
     serial.add_argument("--parity", choices=["N", "E", "O"], default="N", help="parity (default N)")
     serial.add_argument("--stopbits", type=int, choices=[1, 2], default=1, help="stop bits (default 1)")
+    parser.add_argument(
+        "--controllers",
+        type=_controllers,
+        default=None,
+        metavar="N",
+        help="serve N controllers from this process, each on its own port (--port 0: free ports, "
+        "otherwise PORT, PORT+1, ...), with its own arm and its own built-in program running; "
+        "one line per controller is printed; stdin commands apply to every one; TCP only",
+    )
+    parser.add_argument(
+        "--idle", action="store_true", help="with --controllers: no program runs (the arms stand still)"
+    )
     parser.add_argument("--no-stdin", action="store_true", help="do not read commands from stdin")
     parser.add_argument(
         "--stop-with-stdin",
@@ -140,6 +155,16 @@ def _watchdog(text: str) -> float | None:
     if not 0 < seconds <= 60:
         raise argparse.ArgumentTypeError(f"watchdog must be in (0, 60] s or 'off', got {text[:20]!r}")
     return seconds
+
+
+def _controllers(text: str) -> int:
+    try:
+        count = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of controllers, got {text[:20]!r}") from None
+    if not 1 <= count <= MAX_CONTROLLERS:
+        raise argparse.ArgumentTypeError(f"--controllers must be 1..{MAX_CONTROLLERS}, got {count}")
+    return count
 
 
 def _print_status(sim: SimController, _args: list[str], out: TextIO) -> None:
@@ -237,39 +262,52 @@ def execute(sim: SimController, line: str, out: TextIO) -> bool:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    if args.controllers is not None and args.serial:
+        parser.error("--controllers serves TCP ports; it cannot be used with --serial")
     _configure_logging(args.verbose)
     config = _sim_config(args)
-    sim = SimController(config)
-    for point_id in args.refuse_point:
-        sim.refuse_point(point_id)
-    try:
-        sim.start()
-    except OSError as exc:
-        print(f"teachpad-sim: {exc}", file=sys.stderr)
+    fleet = _started_fleet(args, config)
+    if fleet is None:
         return 1
     done = threading.Event()
     previous = _stop_on_signals(done)
     # Announced only now: whoever waits for this line may stop us at once (SIGTERM), and before
     # the handler exists that would kill the process instead of stopping it cleanly.
-    _say(f"teachpad-sim listening on {sim.endpoint} (unit {config.unit}); Ctrl-C to stop")
+    for sim in fleet:
+        _say(f"teachpad-sim listening on {sim.endpoint} (unit {config.unit}); Ctrl-C to stop")
 
     if args.stop_with_stdin:
         watch = threading.Thread(target=_wait_for_end_of_stdin, args=(done,), daemon=True)
         watch.start()
     if not args.no_stdin:
-        threading.Thread(target=_read_commands, args=(sim, done), name="sim-stdin", daemon=True).start()
+        threading.Thread(target=_read_commands, args=(fleet, done), name="sim-stdin", daemon=True).start()
     try:
         while not done.wait(0.2):
             pass
     except KeyboardInterrupt:
         pass
     finally:
-        sim.stop()
+        fleet.stop()
         for sig, handler in previous.items():
             signal.signal(sig, handler)  # type: ignore[arg-type]
     _say("teachpad-sim stopped")
     return 0
+
+
+def _started_fleet(args: argparse.Namespace, config: SimConfig) -> SimFleet | None:
+    """The simulator(s) of the command line, started; None (said on stderr) when one cannot bind."""
+    fleet = SimFleet(args.controllers or 1, config, programs=args.controllers is not None and not args.idle)
+    for sim in fleet:
+        for point_id in args.refuse_point:
+            sim.refuse_point(point_id)
+    try:
+        fleet.start()
+    except OSError as exc:
+        print(f"teachpad-sim: {exc}", file=sys.stderr)
+        return None
+    return fleet
 
 
 def _configure_logging(verbose: bool) -> None:
@@ -303,11 +341,18 @@ def _sim_config(args: argparse.Namespace) -> SimConfig:
     )
 
 
-def _read_commands(sim: SimController, done: threading.Event) -> None:
-    """The stdin commands, one a line, until ``quit`` or the end of stdin; then ``done``."""
+def _read_commands(fleet: SimFleet, done: threading.Event) -> None:
+    """The stdin commands, one a line, until ``quit`` or the end of stdin; then ``done``. With
+    several controllers each command goes to every one."""
     try:
         for line in sys.stdin:
-            if not execute(sim, line, sys.stdout):
+            several = len(fleet) > 1 and line.split()[:1] == ["status"]
+            going = True
+            for sim in fleet:
+                if several:
+                    print(f"-- {sim.endpoint}", flush=True)
+                going = execute(sim, line, sys.stdout) and going
+            if not going:
                 break
     except BrokenPipeError:  # nobody reads our answers any more: stop, quietly
         pass
