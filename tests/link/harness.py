@@ -8,11 +8,12 @@ from typing import Any
 
 from app.connection import ConnectionSettings
 from app.errors import LinkError, Reason
+from app.link.active import MotionTracker
 from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
 from app.link.jog import JogMachine
-from app.link.motion import MotionTracker
 from app.link.poller import Poller
+from app.link.sequence import poll
 from app.link.stats import LinkStats
 from app.link.supervisor import LinkSupervisor
 from app.link.transport import TrafficRecord
@@ -40,8 +41,12 @@ class PartsHost:
         self.motion = MotionTracker()
         self.jog = JogMachine(self)
         self.uploader = Uploader(self)
-        self.poller = Poller(self)
+        self.poller = Poller(self, self.motion)
         self.supervisor = LinkSupervisor(self, canary_gv)
+
+    def poll(self) -> None:
+        """One poll, in the worker's order (app/link/sequence.py)."""
+        poll(self)
 
     # --- what the parts call ---------------------------------------------------------------
     @property
@@ -161,7 +166,7 @@ class PartsHost:
     def poll_until_answered(self, polls: int = 50) -> None:
         """Poll until the link shows CONNECTED again (a loaded machine may need a few polls)."""
         for _ in range(polls):
-            self.poller.poll_once()
+            self.poll()
             if self.supervisor.answering:
                 return
         raise AssertionError(f"no answer in {polls} polls: {self.out[-3:]}")

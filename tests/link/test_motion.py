@@ -6,7 +6,7 @@ import pytest
 
 from app import timing
 from app.errors import Reason
-from app.link.motion import MotionTracker
+from app.link.active import MotionTracker
 from app.link.outcome import Outcome, outcome_of
 from app.link.types import Operation
 from app.link.watch import MotionWatch
