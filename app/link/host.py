@@ -27,7 +27,9 @@ __all__ = [
     "JogView",
     "PartLink",
     "PollerView",
+    "Readings",
     "SupervisorView",
+    "TeachGate",
     "UploaderView",
     "WorkerHost",
     "WorkerOutputs",
@@ -79,20 +81,37 @@ class SupervisorView(Protocol):
     def transport_failed(self, cause: TeachPadError | str) -> None: ...
 
 
-class PollerView(Protocol):
-    """The :class:`~app.link.poller.Poller` as the supervisor, the jog and the commands see it."""
+class Readings(Protocol):
+    """The last pose and status the polls read (:class:`~app.link.poller.Poller`)."""
 
     @property
     def last_pose(self) -> Pose | None: ...
     @property
     def last_status(self) -> ControllerStatus | None: ...
+
+
+class PollerView(Readings, Protocol):
+    """The :class:`~app.link.poller.Poller` as the supervisor sees it."""
+
     def reset(self, now: float) -> None: ...
     def forget(self) -> None: ...
     def publish(self, pose: Pose, status: ControllerStatus, good_at: float | None = None) -> None: ...
 
 
-class JogView(Protocol):
-    """The :class:`~app.link.jog.JogMachine` as the supervisor, the poller and the commands see it."""
+class TeachGate(Protocol):
+    """What a motion or an upload asks the :class:`~app.link.jog.JogMachine` before it starts."""
+
+    def require_no_halt(self, operation: str) -> None:
+        """Refuse ``operation`` while a stop is not confirmed by the controller."""
+        ...
+
+    def leave_teach(self, last_status: ControllerStatus | None) -> None:
+        """Teach mode off (the jog ended) before a command that moves the arm."""
+        ...
+
+
+class JogView(TeachGate, Protocol):
+    """The :class:`~app.link.jog.JogMachine` as the supervisor and the upload see it."""
 
     @property
     def jogging(self) -> bool: ...
@@ -110,8 +129,6 @@ class JogView(Protocol):
     ) -> EnvelopeViolation | None: ...
     def halt_pose(self, pose: Pose) -> None: ...
     def settle_halt(self) -> None: ...
-    def require_no_halt(self, operation: str) -> None: ...
-    def leave_teach(self, last_status: ControllerStatus | None) -> None: ...
 
 
 class UploaderView(Protocol):

@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Callable
 
 from app import timing
 from app.errors import InvalidInput, MalformedResponse, ModbusExceptionError, ResponseTimeout
-from app.link.active import Completion
+from app.link.active import Completion, MotionTracker
 from app.link.client import RobotClient
-from app.link.host import WorkerHost
+from app.link.host import PartLink, Readings, TeachGate
 from app.link.ops import CreatePoint, GoZero, Handlers, MoveToPoint, RunProgram, Step
 from app.link.tracker import CommandTracker
 from app.link.types import Operation
@@ -35,8 +36,21 @@ class MotionCommands:
     """The handlers of the long commands' operations (:mod:`app.link.ops`; worker thread;
     errors propagate to the executor)."""
 
-    def __init__(self, host: WorkerHost) -> None:
+    def __init__(
+        self,
+        host: PartLink,
+        tracker: MotionTracker,
+        teach: TeachGate,
+        readings: Readings,
+        uploading: Callable[[], bool],
+    ) -> None:
+        """``teach``: the jog (a stop unconfirmed refuses, teach mode is left first);
+        ``readings``: the polls' last pose and status; ``uploading``: an upload is under way."""
         self._host = host
+        self._tracker = tracker
+        self._teach = teach
+        self._readings = readings
+        self._uploading = uploading
 
     def register(self, handlers: Handlers) -> None:
         """The operations these handlers run, in the worker's one table."""
@@ -48,13 +62,12 @@ class MotionCommands:
 
     def require_none(self, operation: str) -> None:
         """Refuse ``operation`` while a motion or an upload is under way."""
-        host = self._host
-        host.jog.require_no_halt(operation)
-        busy = host.motion.motion_under_way
+        self._teach.require_no_halt(operation)
+        busy = self._tracker.motion_under_way
         if busy is not None:
             text = f"{busy} is still under way: wait for it or press Stop"
             raise InvalidInput(text, code="busy", params={"operation": busy})
-        if host.uploader.run is not None:
+        if self._uploading():
             raise InvalidInput(
                 f"{Operation.UPLOAD_POINTS} is still under way: wait for it, cancel it or press Stop",
                 code="busy_upload",
@@ -64,11 +77,11 @@ class MotionCommands:
     def _begin(self, operation: str) -> RobotClient:
         self.require_none(operation)
         client = self._host.client_or_raise()
-        self._host.jog.leave_teach(self._host.poller.last_status)
+        self._teach.leave_teach(self._readings.last_status)
         return client
 
     def _track(self, operation: str, completion: Completion, *, motion: bool) -> None:
-        self._host.motion.track(operation, completion, motion=motion, request_id=self._host.request_id)
+        self._tracker.track(operation, completion, motion=motion, request_id=self._host.request_id)
 
     def _track_last(self, client: RobotClient, operation: str, *, motion: bool) -> None:
         tracker = client.last_tracker
@@ -100,7 +113,7 @@ class MotionCommands:
             if tracker.update(status, None, now) is not None or tracker.code_left_pre or now >= deadline:
                 return
             host.run_urgent()  # a stop goes out at once
-            active = host.motion.active
+            active = self._tracker.active
             if active is None or active.completion is not tracker or not host.link_up:
                 return
             time.sleep(tracker.poll_interval(now))
@@ -125,13 +138,13 @@ class MotionCommands:
 
     def go_zero(self, op: GoZero) -> None:
         client = self._begin(Operation.GO_ZERO)
-        before = self._host.poller.last_pose  # (the client reads it when there was no poll yet)
+        before = self._readings.last_pose  # (the client reads it when there was no poll yet)
         completion = client.go_zero(op.axis, before=before, switch_to_auto=op.switch_to_auto)
         self._track(Operation.GO_ZERO, completion, motion=True)
 
     def run_program(self, op: RunProgram) -> None:
         client = self._begin(Operation.RUN_PROGRAM)
-        before = self._host.poller.last_pose
+        before = self._readings.last_pose
         watch = client.run_program(
             op.program_id, op.mode, op.cycles, op.speed_ratio, before=before, switch_to_auto=op.switch_to_auto
         )

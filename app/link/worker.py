@@ -157,13 +157,20 @@ class RobotWorker(QObject):
         self._traffic_timer: QTimer | None = None  # delivers the captured frames while capturing
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
-        self.motions = MotionCommands(self)
-        self.jog = JogMachine(self)
         self.poller = Poller(self, self.motion)
         self.supervisor = LinkSupervisor(self, canary_gv)  # raises on a bad canary GV
         self.stop_line = StopLine()  # the stop's own connection; send_stop from any thread
         # a stop counts on the stop line before its 441 goes out, then (and a cancel) in the queue
         self.uploader = Uploader(self, lambda: self.stop_line.stops_requested + self._jobs.halts)
+        self.jog = JogMachine(
+            self,
+            self.motion,
+            last_pose=lambda: self.poller.last_pose,
+            answering=lambda: self.supervisor.answering,
+        )
+        self.motions = MotionCommands(
+            self, self.motion, self.jog, self.poller, uploading=lambda: self.uploader.run is not None
+        )
         self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
         self.commands = WorkerCommands(self)  # the short commands' handlers
         self.handlers = self._make_handlers()

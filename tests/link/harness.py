@@ -39,10 +39,15 @@ class PartsHost:
         self.caps: MotionCaps | None = None
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
-        self.jog = JogMachine(self)
-        self.uploader = Uploader(self)
         self.poller = Poller(self, self.motion)
         self.supervisor = LinkSupervisor(self, canary_gv)
+        self.uploader = Uploader(self)
+        self.jog = JogMachine(
+            self,
+            self.motion,
+            last_pose=lambda: self.poller.last_pose,
+            answering=lambda: self.supervisor.answering,
+        )
 
     def poll(self) -> None:
         """One poll, in the worker's order (app/link/sequence.py)."""

@@ -155,7 +155,9 @@ def test_motion_commands_start_without_waiting_and_refuse_a_second_motion(sim: o
     host = PartsHost()
     try:
         host.connect(sim)
-        commands = MotionCommands(host)
+        commands = MotionCommands(
+            host, host.motion, host.jog, host.poller, uploading=lambda: host.uploader.run is not None
+        )
         host.request_id = 4
         commands.step(Step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], (0.0,) * 5, 1.0))  # about 0.33 s
         assert host.motion.active is not None and host.motion.active.request_id == 4
