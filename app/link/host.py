@@ -14,8 +14,6 @@ from app.link.types import ConnectionState, UnconfirmedHalt
 from app.models import CommandResult, ControllerStatus, Pose
 
 if TYPE_CHECKING:
-    from app.link.active import MotionTracker
-    from app.link.capture import TrafficCapture
     from app.link.client import RobotClient
     from app.link.stats import LinkStats
     from app.link.transport import TrafficRecord
@@ -182,11 +180,7 @@ class WorkerHost(PartLink, Protocol):
     @property
     def jog(self) -> JogView: ...
     @property
-    def motion(self) -> MotionTracker: ...
-    @property
     def uploader(self) -> UploaderView: ...
-    @property
-    def capture(self) -> TrafficCapture: ...
 
     def run_jobs(self) -> None: ...
 

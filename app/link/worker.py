@@ -158,7 +158,9 @@ class RobotWorker(QObject):
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
         self.poller = Poller(self, self.motion)
-        self.supervisor = LinkSupervisor(self, canary_gv)  # raises on a bad canary GV
+        self.supervisor = LinkSupervisor(  # raises on a bad canary GV
+            self, canary_gv, tracker=self.motion, capture=self.capture
+        )
         self.stop_line = StopLine()  # the stop's own connection; send_stop from any thread
         # a stop counts on the stop line before its 441 goes out, then (and a cancel) in the queue
         self.uploader = Uploader(self, lambda: self.stop_line.stops_requested + self._jobs.halts)

@@ -40,7 +40,7 @@ class PartsHost:
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
         self.poller = Poller(self, self.motion)
-        self.supervisor = LinkSupervisor(self, canary_gv)
+        self.supervisor = LinkSupervisor(self, canary_gv, tracker=self.motion, capture=self.capture)
         self.uploader = Uploader(self)
         self.jog = JogMachine(
             self,
