@@ -14,11 +14,12 @@ from collections.abc import Callable
 from typing import Protocol
 
 from app.errors import LinkError, MalformedResponse, Reason, ResponseTimeout, TeachPadError, WriteBlocked
+from app.link.active import MotionTracker
 from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
 from app.link.jobs import Job
 from app.link.jog import JogMachine
-from app.link.motion import MotionCommands, MotionTracker
+from app.link.motion import MotionCommands
 from app.link.ops import (
     CancelUpload,
     Handlers,

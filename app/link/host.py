@@ -9,25 +9,29 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Protocol
 
-from app.errors import Reason
+from app.errors import Reason, TeachPadError
 from app.link.types import ConnectionState, UnconfirmedHalt
 from app.models import CommandResult, ControllerStatus, Pose
 
 if TYPE_CHECKING:
-    from app.link.capture import TrafficCapture
     from app.link.client import RobotClient
-    from app.link.jog import JogMachine
-    from app.link.motion import MotionTracker
-    from app.link.poller import Poller
     from app.link.stats import LinkStats
-    from app.link.supervisor import LinkSupervisor
     from app.link.transport import TrafficRecord
-    from app.link.upload import Uploader
     from app.safety.audit import AuditLog
     from app.safety.caps import MotionCaps
     from app.safety.envelope import EnvelopeViolation
 
-__all__ = ["WorkerHost", "WorkerOutputs"]
+__all__ = [
+    "JogView",
+    "PartLink",
+    "PollerView",
+    "Readings",
+    "SupervisorView",
+    "TeachGate",
+    "UploaderView",
+    "WorkerHost",
+    "WorkerOutputs",
+]
 
 
 class WorkerOutputs(Protocol):
@@ -56,15 +60,90 @@ class WorkerOutputs(Protocol):
         """A write that stops motion is not confirmed by the controller (None: nothing is)."""
 
 
-class WorkerHost(WorkerOutputs, Protocol):
-    """The worker as its parts use it (worker thread only)."""
+# What one part uses of another, and no more: each view lists exactly the members the other
+# parts reach (this module imports no part, so no part's module is in a circle with another).
 
-    supervisor: LinkSupervisor
-    poller: Poller
-    jog: JogMachine
-    motion: MotionTracker
-    uploader: Uploader
-    capture: TrafficCapture
+
+class SupervisorView(Protocol):
+    """The :class:`~app.link.supervisor.LinkSupervisor` as the poller, the jog and the upload see it."""
+
+    @property
+    def answering(self) -> bool: ...
+    @property
+    def canary_gv(self) -> int | None: ...
+    @property
+    def canary_token(self) -> float | None: ...
+    def canary_read(self, value: float) -> None: ...
+    def poll_answered(self) -> None: ...
+    def poll_silent(self, cause: TeachPadError | str, now: float) -> None: ...
+    def transport_failed(self, cause: TeachPadError | str) -> None: ...
+
+
+class Readings(Protocol):
+    """The last pose and status the polls read (:class:`~app.link.poller.Poller`)."""
+
+    @property
+    def last_pose(self) -> Pose | None: ...
+    @property
+    def last_status(self) -> ControllerStatus | None: ...
+
+
+class PollerView(Readings, Protocol):
+    """The :class:`~app.link.poller.Poller` as the supervisor sees it."""
+
+    def reset(self, now: float) -> None: ...
+    def forget(self) -> None: ...
+    def publish(self, pose: Pose, status: ControllerStatus, good_at: float | None = None) -> None: ...
+
+
+class TeachGate(Protocol):
+    """What a motion or an upload asks the :class:`~app.link.jog.JogMachine` before it starts."""
+
+    def require_no_halt(self, operation: str) -> None:
+        """Refuse ``operation`` while a stop is not confirmed by the controller."""
+        ...
+
+    def leave_teach(self, last_status: ControllerStatus | None) -> None:
+        """Teach mode off (the jog ended) before a command that moves the arm."""
+        ...
+
+
+class JogView(TeachGate, Protocol):
+    """The :class:`~app.link.jog.JogMachine` as the supervisor and the upload see it."""
+
+    @property
+    def jogging(self) -> bool: ...
+    @property
+    def halting(self) -> bool: ...
+    def reset(self) -> None: ...
+    def link_lost(self) -> None: ...
+    def controller_silent(self) -> None: ...
+    def controller_answers(self) -> None: ...
+    def make_teach_safe(self, status: ControllerStatus, ever_connected: bool) -> None: ...
+    def stop_jog_and_teach(self) -> None: ...
+    def after_status(self, status: ControllerStatus, now: float, *, idle: bool) -> None: ...
+    def guard_pose(
+        self, pose: Pose, read_at: float | None = None, answered_at: float | None = None
+    ) -> EnvelopeViolation | None: ...
+    def halt_pose(self, pose: Pose) -> None: ...
+    def settle_halt(self) -> None: ...
+
+
+class UploaderView(Protocol):
+    """The :class:`~app.link.upload.Uploader` as the supervisor and the commands see it."""
+
+    @property
+    def run(self) -> object | None:
+        """The upload under way (None: none)."""
+        ...
+
+    def end(self, reason: str) -> None: ...
+
+
+class PartLink(WorkerOutputs, Protocol):
+    """What every part may use of the worker: the client, the urgent jobs, the emitters (worker
+    thread only); no sibling."""
+
     closed: bool
     audit: AuditLog | None  # given to each new client (thread-safe)
     caps: MotionCaps | None  # reduced-speed mode's caps, given to each new client
@@ -82,6 +161,27 @@ class WorkerHost(WorkerOutputs, Protocol):
         """Run the urgent jobs queued now (stop, release, ...); True if any ran."""
         ...
 
+    def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None: ...
+
+    def emit_error(
+        self, operation: str, message: str, request_id: int | None = -1, reason: Reason | None = None
+    ) -> None: ...
+
+    def emit_exception(self, operation: str, exc: BaseException, request_id: int | None = -1) -> None: ...
+
+
+class WorkerHost(PartLink, Protocol):
+    """The worker as the parts not yet narrowed use it: the siblings through their views."""
+
+    @property
+    def supervisor(self) -> SupervisorView: ...
+    @property
+    def poller(self) -> PollerView: ...
+    @property
+    def jog(self) -> JogView: ...
+    @property
+    def uploader(self) -> UploaderView: ...
+
     def run_jobs(self) -> None: ...
 
     def poll_if_due(self) -> None:
@@ -93,14 +193,6 @@ class WorkerHost(WorkerOutputs, Protocol):
     def flush_traffic(self) -> None:
         """Publish the frames captured so far now (the worker also does on its own period)."""
         ...
-
-    def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None: ...
-
-    def emit_error(
-        self, operation: str, message: str, request_id: int | None = -1, reason: Reason | None = None
-    ) -> None: ...
-
-    def emit_exception(self, operation: str, exc: BaseException, request_id: int | None = -1) -> None: ...
 
     def start_polling(self) -> None: ...
 

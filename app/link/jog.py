@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import dataclasses
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 from app import timing
@@ -29,8 +30,9 @@ from app.errors import (
     Reason,
     TeachPadError,
 )
+from app.link.active import MotionTracker
 from app.link.halt import HaltWatch, HaltWrite, halt_refusal
-from app.link.host import WorkerHost
+from app.link.host import PartLink
 from app.link.outcome import UNKNOWN_ADVICE
 from app.link.tracker import CommandTracker
 from app.link.types import HaltKind, JogRequest, Operation, UnconfirmedHalt
@@ -64,8 +66,20 @@ class PreemptedError(Exception):
 class JogMachine:
     """Teach mode and the held jog; every write goes through the host's client."""
 
-    def __init__(self, host: WorkerHost) -> None:
+    def __init__(
+        self,
+        host: PartLink,
+        tracker: MotionTracker,
+        *,
+        last_pose: Callable[[], Pose | None],
+        answering: Callable[[], bool],
+    ) -> None:
+        """``tracker``: the command under way (a stop ends it); ``last_pose``: the polls' last
+        pose (the jog guard's start); ``answering``: the controller answers the polls."""
         self._host = host
+        self._tracker = tracker
+        self._last_pose = last_pose
+        self._answering = answering
         self.teach = TeachState()
         self.teach_dirty = False  # teach may be on at the controller though we could not switch it off
         self.jog: JogRequest | None = None
@@ -245,7 +259,7 @@ class JogMachine:
         A release or stop arriving in between ends the sequence before the ratio is written.
         """
         client = self._host.client_or_raise()
-        if not self._host.supervisor.answering:  # refused before the wire; not a link failure
+        if not self._answering():  # refused before the wire; not a link failure
             raise TeachPadError("the controller is not answering: jog not started", code="jog_not_answering")
         if not 0.0 < request.ratio <= 100.0:
             raise InvalidInput(
@@ -326,7 +340,7 @@ class JogMachine:
     def _require_guard(self, request: JogRequest) -> None:
         """Raise :class:`EnvelopeRefused` (nothing written) when the guard would stop this jog now.
         Without a pose yet there is nothing to decide on: the first poll decides."""
-        guard, pose = self.guard, self._host.poller.last_pose
+        guard, pose = self.guard, self._last_pose()
         if guard is None or pose is None:
             return
         # A standing arm's last pose is still where it is; a moving one's has aged since its read.
@@ -497,7 +511,7 @@ class JogMachine:
         halt = self.halt
         if halt is not None:
             halt.took(HaltWrite.STOP, time.monotonic())
-        active = self._host.motion.take()
+        active = self._tracker.take()
         if active is not None:
             self._host.emit_result(active.completion.stopped(time.monotonic()), active.request_id)
 

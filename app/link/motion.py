@@ -11,22 +11,20 @@ under way is refused.
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import time
-from dataclasses import dataclass
-from typing import Protocol
+from collections.abc import Callable
 
 from app import timing
-from app.errors import InvalidInput, MalformedResponse, ModbusExceptionError, Reason, ResponseTimeout
+from app.errors import InvalidInput, MalformedResponse, ModbusExceptionError, ResponseTimeout
+from app.link.active import Completion, MotionTracker
 from app.link.client import RobotClient
-from app.link.host import WorkerHost
+from app.link.host import PartLink, Readings, TeachGate
 from app.link.ops import CreatePoint, GoZero, Handlers, MoveToPoint, RunProgram, Step
 from app.link.tracker import CommandTracker
 from app.link.types import Operation
-from app.models import CommandResult, ControllerStatus, Pose
 
-__all__ = ["ActiveCommand", "Completion", "MotionCommands", "MotionTracker"]
+__all__ = ["MotionCommands"]
 
 _log = logging.getLogger(__name__)
 
@@ -34,71 +32,25 @@ _log = logging.getLogger(__name__)
 _READ_ERRORS = (ModbusExceptionError, ResponseTimeout, MalformedResponse)
 
 
-class Completion(Protocol):
-    @property
-    def deadline(self) -> float: ...
-
-    def update(self, status: ControllerStatus, pose: Pose | None, now: float) -> CommandResult | None: ...
-
-    def stopped(self, now: float) -> CommandResult: ...
-
-    def unknown(
-        self, now: float, cause: object = None, *, message: str | None = None, reason: Reason | None = None
-    ) -> CommandResult: ...
-
-
-@dataclass
-class ActiveCommand:
-    operation: str
-    completion: Completion
-    motion: bool  # a motion (blocks other motions) rather than a short command
-    request_id: int | None = None
-
-
-class MotionTracker:
-    """The active command and its completion; fed by every good poll (worker thread only)."""
-
-    def __init__(self) -> None:
-        self.active: ActiveCommand | None = None
-
-    @property
-    def motion_under_way(self) -> str | None:
-        """The operation of the motion under way (None when there is none)."""
-        active = self.active
-        return active.operation if active is not None and active.motion else None
-
-    def track(self, operation: str, completion: Completion, *, motion: bool, request_id: int | None) -> None:
-        self.active = ActiveCommand(operation, completion, motion, request_id)
-
-    def take(self) -> ActiveCommand | None:
-        """Forget the active command and return it (stop, link loss, close)."""
-        active, self.active = self.active, None
-        return active
-
-    def update(
-        self, status: ControllerStatus, pose: Pose, now: float
-    ) -> tuple[CommandResult, int | None] | None:
-        """Feed one poll (status read before pose); the result and its request id once it ended."""
-        active = self.active
-        if active is None:
-            return None
-        result = active.completion.update(status, pose, now)
-        if result is None:
-            return None
-        self.active = None
-        if active.operation == Operation.CREATE_POINT and result.ok:
-            details = dict(result.details)
-            details.update(zip(("x", "y", "z", "a", "b", "c"), pose.xyzabc, strict=True))
-            result = dataclasses.replace(result, details=details)
-        return result, active.request_id
-
-
 class MotionCommands:
     """The handlers of the long commands' operations (:mod:`app.link.ops`; worker thread;
     errors propagate to the executor)."""
 
-    def __init__(self, host: WorkerHost) -> None:
+    def __init__(
+        self,
+        host: PartLink,
+        tracker: MotionTracker,
+        teach: TeachGate,
+        readings: Readings,
+        uploading: Callable[[], bool],
+    ) -> None:
+        """``teach``: the jog (a stop unconfirmed refuses, teach mode is left first);
+        ``readings``: the polls' last pose and status; ``uploading``: an upload is under way."""
         self._host = host
+        self._tracker = tracker
+        self._teach = teach
+        self._readings = readings
+        self._uploading = uploading
 
     def register(self, handlers: Handlers) -> None:
         """The operations these handlers run, in the worker's one table."""
@@ -110,13 +62,12 @@ class MotionCommands:
 
     def require_none(self, operation: str) -> None:
         """Refuse ``operation`` while a motion or an upload is under way."""
-        host = self._host
-        host.jog.require_no_halt(operation)
-        busy = host.motion.motion_under_way
+        self._teach.require_no_halt(operation)
+        busy = self._tracker.motion_under_way
         if busy is not None:
             text = f"{busy} is still under way: wait for it or press Stop"
             raise InvalidInput(text, code="busy", params={"operation": busy})
-        if host.uploader.run is not None:
+        if self._uploading():
             raise InvalidInput(
                 f"{Operation.UPLOAD_POINTS} is still under way: wait for it, cancel it or press Stop",
                 code="busy_upload",
@@ -126,11 +77,11 @@ class MotionCommands:
     def _begin(self, operation: str) -> RobotClient:
         self.require_none(operation)
         client = self._host.client_or_raise()
-        self._host.jog.leave_teach(self._host.poller.last_status)
+        self._teach.leave_teach(self._readings.last_status)
         return client
 
     def _track(self, operation: str, completion: Completion, *, motion: bool) -> None:
-        self._host.motion.track(operation, completion, motion=motion, request_id=self._host.request_id)
+        self._tracker.track(operation, completion, motion=motion, request_id=self._host.request_id)
 
     def _track_last(self, client: RobotClient, operation: str, *, motion: bool) -> None:
         tracker = client.last_tracker
@@ -162,7 +113,7 @@ class MotionCommands:
             if tracker.update(status, None, now) is not None or tracker.code_left_pre or now >= deadline:
                 return
             host.run_urgent()  # a stop goes out at once
-            active = host.motion.active
+            active = self._tracker.active
             if active is None or active.completion is not tracker or not host.link_up:
                 return
             time.sleep(tracker.poll_interval(now))
@@ -187,13 +138,13 @@ class MotionCommands:
 
     def go_zero(self, op: GoZero) -> None:
         client = self._begin(Operation.GO_ZERO)
-        before = self._host.poller.last_pose  # (the client reads it when there was no poll yet)
+        before = self._readings.last_pose  # (the client reads it when there was no poll yet)
         completion = client.go_zero(op.axis, before=before, switch_to_auto=op.switch_to_auto)
         self._track(Operation.GO_ZERO, completion, motion=True)
 
     def run_program(self, op: RunProgram) -> None:
         client = self._begin(Operation.RUN_PROGRAM)
-        before = self._host.poller.last_pose
+        before = self._readings.last_pose
         watch = client.run_program(
             op.program_id, op.mode, op.cycles, op.speed_ratio, before=before, switch_to_auto=op.switch_to_auto
         )

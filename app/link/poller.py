@@ -3,10 +3,13 @@
 Order of a poll: a stop the controller has not confirmed goes out again first
 (:meth:`~app.link.jog.JogMachine.settle_halt`); then **status first, then pose** -- so when the
 status says a motion ended, the pose read after it is the final one -- with the urgent jobs run
-between the two reads. Then, in this order: one ``publish_polled`` of the pose / status /
-alarms (each only on change) and of the good poll, the restart canary, ``commandFinished`` of
-the command the poll completed, the RTT and the link statistics (the captured traffic goes out
-on the worker's own period, not per poll: see :mod:`app.link.worker`). The clock (and the
+between the two reads, the jog guard and the halt watch seeing the pose at once. The poller
+returns what the poll read (:class:`Polled`, or :class:`PollFailed`) and
+:func:`app.link.sequence.poll` hands it on, in this order: one ``publish_polled`` of the pose /
+status / alarms (each only on change) and of the good poll, the restart canary (the supervisor),
+``commandFinished`` of the command the poll completed (the tracker), the jog's teach watch, the
+RTT and the link statistics (the captured traffic goes out on the worker's own period, not per
+poll: see :mod:`app.link.worker`). The poller calls no other part. The clock (and the
 canary) are read every :data:`app.timing.CLOCK_POLL_PERIOD`. Polls use the poll timeout
 (``settings.effective_poll_timeout``), not the command timeout: a silent controller shows as
 ``NOT_ANSWERING`` after one poll.
@@ -17,18 +20,21 @@ from __future__ import annotations
 import dataclasses
 import logging
 import time
+from collections.abc import Callable
+from typing import Protocol
 
 from app import timing
 from app.errors import LinkError, MalformedResponse, ResponseTimeout, TeachPadError
+from app.link.active import MotionTracker
 from app.link.capture import LinkStatsReporter, RttMeter
 from app.link.client import RobotClient
 from app.link.foreign import audit_sighting
-from app.link.host import WorkerHost
+from app.link.host import PartLink
 from app.link.types import Operation
 from app.models import ControllerStatus, Pose
 from app.safety.envelope import EnvelopeViolation
 
-__all__ = ["JOG_POLL_HZ_MIN", "Poller"]
+__all__ = ["JOG_POLL_HZ_MIN", "PollFailed", "Polled", "Poller", "PoseWatch"]
 
 #: While a jog is held (or teach mode moves at a non-zero ratio) the poller keeps at least this
 #: rate whatever the GUI's setting: the controller's watchdog (0.3 s on the simulator) stops a jog
@@ -36,6 +42,24 @@ __all__ = ["JOG_POLL_HZ_MIN", "Poller"]
 JOG_POLL_HZ_MIN = 10.0
 
 _log = logging.getLogger(__name__)
+
+
+class PoseWatch(Protocol):
+    """What watches a poll's reads as they come (the jog: :class:`~app.link.jog.JogMachine`)."""
+
+    def settle_halt(self) -> None:
+        """A stop the controller has not confirmed: written again, before the reads."""
+        ...
+
+    def guard_pose(
+        self, pose: Pose, read_at: float | None = None, answered_at: float | None = None
+    ) -> EnvelopeViolation | None:
+        """The jog guard's check of the pose just read (ratio 0 before a boundary)."""
+        ...
+
+    def halt_pose(self, pose: Pose) -> None:
+        """A jog's stop is over once answered and the pose is still."""
+        ...
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -49,11 +73,40 @@ class _Reading:
     read_time: float  # s: the two reads' time on the wire, for the RTT
 
 
-class Poller:
-    """Reads, publishes on change, feeds the active command and the jog's teach watch."""
+@dataclasses.dataclass(frozen=True, slots=True)
+class Polled:
+    """A good poll, to hand on (:func:`app.link.sequence.poll`)."""
 
-    def __init__(self, host: WorkerHost) -> None:
+    client: RobotClient
+    reading: _Reading
+    started: float  # monotonic: when the poll began
+    answered: float  # monotonic: when its reads were done
+    with_clock: bool  # the slow clock's reads (controller clock, canary) were made
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class PollFailed:
+    """A failed poll, to hand on: silence and a failed transaction go to the supervisor."""
+
+    error: TeachPadError
+
+    @property
+    def silent(self) -> bool:
+        """No answer in time (the link still open)."""
+        return isinstance(self.error, ResponseTimeout)
+
+    @property
+    def transport_failed(self) -> bool:
+        """The transaction failed (a malformed answer too: the transport counted it)."""
+        return isinstance(self.error, (LinkError, MalformedResponse))
+
+
+class Poller:
+    """Reads and returns what it read; publishes on change, tells the command its polls fail."""
+
+    def __init__(self, host: PartLink, tracker: MotionTracker) -> None:
         self._host = host
+        self._tracker = tracker
         self.last_pose: Pose | None = None
         self.last_status: ControllerStatus | None = None
         self._last_alarms: int | None = None
@@ -64,10 +117,11 @@ class Poller:
         self.rtt = RttMeter(timing.RTT_REPORT_PERIOD)
         self.stats = LinkStatsReporter(timing.RTT_REPORT_PERIOD)
 
-    def rate(self, setting_hz: float) -> float:
-        """The poll rate to use now: the GUI's setting, at least :data:`JOG_POLL_HZ_MIN` while jogging."""
-        jog = self._host.jog
-        if jog.jogging or jog.halting:  # a jog's stop is confirmed by polls too (app/link/halt.py)
+    @staticmethod
+    def rate(setting_hz: float, *, jogging: bool) -> float:
+        """The poll rate to use now: the GUI's setting, at least :data:`JOG_POLL_HZ_MIN` while
+        ``jogging`` (a jog held or halting: a jog's stop is confirmed by polls too, app/link/halt.py)."""
+        if jogging:
             return max(setting_hz, JOG_POLL_HZ_MIN)
         return setting_hz
 
@@ -103,28 +157,41 @@ class Poller:
         if new_pose is not None or new_status is not None or new_alarms is not None or good_at is not None:
             self._host.publish_polled(new_pose, new_status, new_alarms, good_at)
 
-    def poll_once(self) -> None:
+    def poll_once(
+        self, watch: PoseWatch, *, settle: bool, canary_gv: Callable[[], int | None]
+    ) -> Polled | PollFailed | None:
+        """One poll's reads (None: no client, or the link went down meanwhile). ``settle``: the
+        controller answers, so an unconfirmed stop is written again first; ``canary_gv``: the
+        restart canary's GV to read on the slow clock (None: not checking), asked after the reads."""
         client = self._host.client
         if client is None:
-            return
+            return None
         now = time.monotonic()
         self.last_poll = now
         with_clock = now >= self._next_clock
         try:
-            reading = self._read(client, with_clock)
+            reading = self._read(client, watch, settle=settle, with_clock=with_clock, canary_gv=canary_gv)
         except TeachPadError as exc:
-            self._poll_failed(exc)
-            return
-        if reading is not None:
-            self._poll_answered(client, reading, now, with_clock)
+            return PollFailed(exc)
+        if reading is None:
+            return None
+        return Polled(client, reading, now, time.monotonic(), with_clock)
 
-    def _read(self, client: RobotClient, with_clock: bool) -> _Reading | None:
+    def _read(
+        self,
+        client: RobotClient,
+        watch: PoseWatch,
+        *,
+        settle: bool,
+        with_clock: bool,
+        canary_gv: Callable[[], int | None],
+    ) -> _Reading | None:
         """The poll's reads, status first, then pose, the urgent jobs run between them and after
         them (None: the link went down meanwhile), and the canary on the slow clock."""
         host = self._host
         timeout = client.settings.effective_poll_timeout
-        if host.supervisor.answering:
-            host.jog.settle_halt()  # a stop the controller has not confirmed: again, first
+        if settle:
+            watch.settle_halt()  # a stop the controller has not confirmed: again, first
         t0 = time.perf_counter()
         status = client.read_status(with_clock=with_clock, timeout=timeout)
         t1 = time.perf_counter()
@@ -134,59 +201,43 @@ class Poller:
         t2 = time.perf_counter()
         pose = client.read_pose(timeout=timeout)
         t3 = time.perf_counter()
-        guard_stop = host.jog.guard_pose(pose, t2, t3)  # ratio 0 before the TCP crosses a boundary
-        host.jog.halt_pose(pose)  # a jog's stop is over once answered and the pose is still
+        guard_stop = watch.guard_pose(pose, t2, t3)  # ratio 0 before the TCP crosses a boundary
+        watch.halt_pose(pose)  # a jog's stop is over once answered and the pose is still
         host.run_urgent()  # and before this poll's publishing: a stop waits one read at most
         if not host.link_up:
             return None
         canary: float | None = None
-        gv = host.supervisor.canary_gv
-        if with_clock and host.supervisor.canary_token is not None and gv is not None:
+        gv = canary_gv() if with_clock else None
+        if gv is not None:
             canary = client.read_gv(gv)[0]  # the restart canary, on the slow clock
         return _Reading(status, pose, guard_stop, canary, (t1 - t0) + (t3 - t2))
 
-    def _poll_failed(self, exc: TeachPadError) -> None:
-        """A failed poll: reported once per distinct error, the command in flight told; silence
-        and a failed transaction go to the supervisor."""
-        host = self._host
+    def failed(self, exc: TeachPadError) -> None:
+        """A failed poll: reported once per distinct error, the command in flight told."""
         self._report_error(exc)
         self._command_unread(exc)
-        if isinstance(exc, ResponseTimeout):
-            host.supervisor.poll_silent(exc, time.monotonic())
-        elif isinstance(exc, (LinkError, MalformedResponse)):
-            # A malformed answer is a failed poll: the transport counted it and resynchronised
-            # (a TCP link is reopened by the next request); none of its values are published;
-            # LINK_LOSS_POLLS of them in a row take the link down like any failed transaction.
-            host.supervisor.transport_failed(exc)
-        else:
-            return
-        self._report_stats()
 
-    def _poll_answered(self, client: RobotClient, reading: _Reading, now: float, with_clock: bool) -> None:
-        """A good poll: published, then the canary, another master's signs, the command in
-        flight, the jog, the RTT and the link statistics."""
-        host = self._host
-        answered = time.monotonic()
+    def answered(self) -> None:
+        """A good poll: the errors reported so far are over."""
         self._error = None
         self._unread_since = None
-        host.supervisor.poll_answered()
-        if not host.link_up:
-            return
+
+    def publish_reading(self, polled: Polled) -> tuple[ControllerStatus, Pose]:
+        """A good poll's delivery (the jog guard's stop, then the changes); its status (with the
+        controller's clock) and pose."""
+        reading = polled.reading
         if reading.guard_stop is not None:
-            host.publish_guard_stop(reading.guard_stop)
-        status, pose = self._clocked(client, reading.status, now, with_clock), reading.pose
-        self.publish(pose, status, good_at=answered)
-        if reading.canary is not None:
-            host.supervisor.canary_read(reading.canary)
-        self._report_foreign(client)
-        done = host.motion.update(status, pose, answered)
-        if done is not None:
-            host.emit_result(*done)
-        host.jog.after_status(status, answered, idle=host.motion.active is None)
-        rtt = self.rtt.note(reading.read_time, 2, answered)
+            self._host.publish_guard_stop(reading.guard_stop)
+        status = self._clocked(polled.client, reading.status, polled.started, polled.with_clock)
+        self.publish(reading.pose, status, good_at=polled.answered)
+        return status, reading.pose
+
+    def report_rtt(self, polled: Polled) -> None:
+        """The RTT of a good poll's reads, when one is due, then the link statistics."""
+        rtt = self.rtt.note(polled.reading.read_time, 2, polled.answered)
         if rtt is not None:
-            host.publish_rtt(rtt)
-        self._report_stats()
+            self._host.publish_rtt(rtt)
+        self.report_stats()
 
     def _clocked(
         self, client: RobotClient, status: ControllerStatus, now: float, with_clock: bool
@@ -206,8 +257,8 @@ class Poller:
         on reading; once they failed for ``timing.OUTCOME_READ_BUDGET`` and the command's own time
         ran out, it ends *unknown* ("sent; the outcome is unknown -- check the robot ..."), never
         failed (issue 19 section 3; the CLI's ``CommandClient.follow`` keeps the same rule)."""
-        host = self._host
-        active = host.motion.active
+        tracker = self._tracker
+        active = tracker.active
         if active is None:
             self._unread_since = None
             return
@@ -217,18 +268,18 @@ class Poller:
         completion = active.completion
         if now < max(self._unread_since + timing.OUTCOME_READ_BUDGET, completion.deadline):
             return
-        host.motion.take()
+        tracker.take()
         self._unread_since = None
-        host.emit_result(completion.unknown(now, exc), active.request_id)
+        self._host.emit_result(completion.unknown(now, exc), active.request_id)
 
-    def _report_foreign(self, client: RobotClient) -> None:
+    def report_foreign(self, client: RobotClient) -> None:
         """Another master's signs seen by this poll (app/link/foreign.py): logged, audited, published."""
         for sighting in client.foreign.take():
             _log.warning("%s", sighting.message)
             audit_sighting(client.audit, sighting)
             self._host.publish_foreign_master(sighting.what, sighting.value)
 
-    def _report_stats(self) -> None:
+    def report_stats(self) -> None:
         client = self._host.client
         if client is not None:
             stats = self.stats.due(client.stats, time.monotonic())

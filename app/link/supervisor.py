@@ -32,6 +32,8 @@ import time
 from app import timing
 from app.connection import ConnectionSettings
 from app.errors import LinkError, Reason, ResponseTimeout, TeachPadError
+from app.link.active import MotionTracker
+from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
 from app.link.foreign import ForeignSighting
 from app.link.host import WorkerHost
@@ -60,9 +62,15 @@ def check_canary_gv(canary_gv: int | None) -> None:
 class LinkSupervisor:
     """Owns the client and the link state."""
 
-    def __init__(self, host: WorkerHost, canary_gv: int | None) -> None:
+    def __init__(
+        self, host: WorkerHost, canary_gv: int | None, *, tracker: MotionTracker, capture: TrafficCapture
+    ) -> None:
+        """``tracker``: the command under way (its outcome unknown when the link goes);
+        ``capture``: the traffic recorder, attached to each new client."""
         check_canary_gv(canary_gv)
         self._host = host
+        self._tracker = tracker
+        self._capture = capture
         self.canary_gv = canary_gv
         self.client: RobotClient | None = None
         self.settings: ConnectionSettings | None = None
@@ -108,7 +116,7 @@ class LinkSupervisor:
         # another master's parameter / command writes: the shared registers read with a status
         # read once a clock period (polls, and the reads of uploads and command waits alike)
         self.client.watch_shared_every = timing.CLOCK_POLL_PERIOD
-        host.capture.attach(self.client)
+        self._capture.attach(self.client)
         self._ever_connected = False
         self._backoff_index = 0
         host.jog.reset()
@@ -393,7 +401,7 @@ class LinkSupervisor:
         self.link_up = False
         self.answering = True
         if client is not None:
-            host.capture.detach(client)
+            self._capture.detach(client)
             client.close()
         self.client = None
         host.poller.forget()
@@ -401,7 +409,7 @@ class LinkSupervisor:
             self.set_state(state, message)
 
     def _fail_active(self, message: str, code: str) -> None:
-        active = self._host.motion.take()
+        active = self._tracker.take()
         if active is not None:
             # its outcome is unknown: said so, and recorded so against its command in the audit
             result = active.completion.unknown(

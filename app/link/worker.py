@@ -71,14 +71,16 @@ from app.errors import (
     TeachPadError,
     WriteBlocked,
 )
+from app.link.active import MotionTracker
 from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
 from app.link.commands import WorkerCommands
 from app.link.jobs import Job, JobQueue
 from app.link.jog import JogMachine, PreemptedError
-from app.link.motion import MotionCommands, MotionTracker
+from app.link.motion import MotionCommands
 from app.link.ops import CancelUpload, Handlers, LinkOp, Stop
 from app.link.poller import Poller
+from app.link.sequence import poll
 from app.link.state import PollUpdate
 from app.link.stats import LinkStats
 from app.link.stop_line import StopLine
@@ -155,13 +157,22 @@ class RobotWorker(QObject):
         self._traffic_timer: QTimer | None = None  # delivers the captured frames while capturing
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
-        self.motions = MotionCommands(self)
-        self.jog = JogMachine(self)
-        self.poller = Poller(self)
-        self.supervisor = LinkSupervisor(self, canary_gv)  # raises on a bad canary GV
+        self.poller = Poller(self, self.motion)
+        self.supervisor = LinkSupervisor(  # raises on a bad canary GV
+            self, canary_gv, tracker=self.motion, capture=self.capture
+        )
         self.stop_line = StopLine()  # the stop's own connection; send_stop from any thread
         # a stop counts on the stop line before its 441 goes out, then (and a cancel) in the queue
         self.uploader = Uploader(self, lambda: self.stop_line.stops_requested + self._jobs.halts)
+        self.jog = JogMachine(
+            self,
+            self.motion,
+            last_pose=lambda: self.poller.last_pose,
+            answering=lambda: self.supervisor.answering,
+        )
+        self.motions = MotionCommands(
+            self, self.motion, self.jog, self.poller, uploading=lambda: self.uploader.run is not None
+        )
         self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
         self.commands = WorkerCommands(self)  # the short commands' handlers
         self.handlers = self._make_handlers()
@@ -295,7 +306,11 @@ class RobotWorker(QObject):
                 timer.stop()
 
     def _poll_interval_ms(self) -> int:
-        return max(1, round(1000.0 / self.poller.rate(self._poll_hz)))
+        return max(1, round(1000.0 / self._poll_rate()))
+
+    def _poll_rate(self) -> float:
+        """The poll rate now: the GUI's setting, raised while a jog is held or halting (poller.py)."""
+        return self.poller.rate(self._poll_hz, jogging=self.jog.jogging or self.jog.halting)
 
     def _follow_poll_rate(self) -> None:
         """Keep the timer at the poller's rate (faster while jogging, see ``Poller.rate``)."""
@@ -332,7 +347,7 @@ class RobotWorker(QObject):
         return client
 
     def poll_if_due(self) -> None:
-        if time.monotonic() - self.poller.last_poll >= 1.0 / self.poller.rate(self._poll_hz):
+        if time.monotonic() - self.poller.last_poll >= 1.0 / self._poll_rate():
             self._poll()
 
     def start_polling(self) -> None:
@@ -453,7 +468,7 @@ class RobotWorker(QObject):
         """One poll; results emitted from here belong to no request (even inside a job)."""
         outer_id, self.request_id = self.request_id, None
         try:
-            self.poller.poll_once()
+            poll(self)  # the poller reads; its outcome handed to the parts in order
         finally:
             self.request_id = outer_id
 

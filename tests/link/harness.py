@@ -8,11 +8,12 @@ from typing import Any
 
 from app.connection import ConnectionSettings
 from app.errors import LinkError, Reason
+from app.link.active import MotionTracker
 from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
 from app.link.jog import JogMachine
-from app.link.motion import MotionTracker
 from app.link.poller import Poller
+from app.link.sequence import poll
 from app.link.stats import LinkStats
 from app.link.supervisor import LinkSupervisor
 from app.link.transport import TrafficRecord
@@ -38,10 +39,19 @@ class PartsHost:
         self.caps: MotionCaps | None = None
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
-        self.jog = JogMachine(self)
+        self.poller = Poller(self, self.motion)
+        self.supervisor = LinkSupervisor(self, canary_gv, tracker=self.motion, capture=self.capture)
         self.uploader = Uploader(self)
-        self.poller = Poller(self)
-        self.supervisor = LinkSupervisor(self, canary_gv)
+        self.jog = JogMachine(
+            self,
+            self.motion,
+            last_pose=lambda: self.poller.last_pose,
+            answering=lambda: self.supervisor.answering,
+        )
+
+    def poll(self) -> None:
+        """One poll, in the worker's order (app/link/sequence.py)."""
+        poll(self)
 
     # --- what the parts call ---------------------------------------------------------------
     @property
@@ -161,7 +171,7 @@ class PartsHost:
     def poll_until_answered(self, polls: int = 50) -> None:
         """Poll until the link shows CONNECTED again (a loaded machine may need a few polls)."""
         for _ in range(polls):
-            self.poller.poll_once()
+            self.poll()
             if self.supervisor.answering:
                 return
         raise AssertionError(f"no answer in {polls} polls: {self.out[-3:]}")

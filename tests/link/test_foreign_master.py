@@ -58,7 +58,7 @@ def test_another_teachpads_canary_token_is_not_a_restart(sim: Any, fast_canary: 
         canary_reads = 0
         while canary_reads < 40:  # 40 fights of the old rule, each read back by our canary poll
             other.write_gv(CANARY_GV, [float(next(tokens))])
-            parts.poller.poll_once()
+            parts.poll()
             canary_reads += 1
         assert "controllerRestarted" not in parts.names()
         assert len(sim.writes_to(CANARY_REG)) - our_writes == 40  # the other master's only: no fight
@@ -69,7 +69,7 @@ def test_another_teachpads_canary_token_is_not_a_restart(sim: Any, fast_canary: 
         sim.restart_controller()
         deadline = time.monotonic() + 10.0
         while "controllerRestarted" not in parts.names() and time.monotonic() < deadline:
-            parts.poller.poll_once()
+            parts.poll()
         assert parts.names().count("controllerRestarted") == 1
         assert not _identity(parts).same_boot(one)
     finally:
@@ -86,7 +86,7 @@ def test_a_reconnect_keeps_the_boot_when_the_canary_holds_the_token_another_mast
         parts.connect(sim)
         one = _identity(parts)
         other.write_gv(CANARY_GV, [4242.0])
-        parts.poller.poll_once()
+        parts.poll()
         parts.supervisor.link_lost("test")
         parts.supervisor.try_connect()
         assert _identity(parts).same_boot(one)
@@ -106,12 +106,12 @@ def test_another_masters_command_result_is_seen_within_a_second_and_audited(
         parts.connect(sim)
         deadline = time.monotonic() + 0.5
         while time.monotonic() < deadline:  # our own connect writes are long settled
-            parts.poller.poll_once()
+            parts.poll()
         assert "foreignMaster" not in parts.names()
         started = time.monotonic()
         other.create_point(7, pose=[400.0, 0.0, 300.0, 180.0, 0.0, 0.0])  # another master's command
         while "foreignMaster" not in parts.names() and time.monotonic() - started < 5.0:
-            parts.poller.poll_once()
+            parts.poll()
         assert time.monotonic() - started < 1.0 + 2.0  # seen at the next poll (slack for a loaded box)
         assert parts.of("foreignMaster")[0] == ("gv291", 255.0)
         records = [r for r in _audit_lines(tmp_path) if "another Modbus master" in r]
@@ -212,21 +212,21 @@ def test_both_teachpads_see_a_restart_before_either_writes_a_fresh_token(
     try:
         first.connect(sim)
         second.connect(sim)
-        first.poller.poll_once()  # the second's token: another master, not a restart
+        first.poll()  # the second's token: another master, not a restart
         sim.restart_controller()
-        first.poller.poll_once()
-        first.poller.poll_once()
+        first.poll()
+        first.poll()
         assert first.names().count("controllerRestarted") == 1
-        second.poller.poll_once()
+        second.poll()
         assert second.names().count("controllerRestarted") == 1  # it saw the 0 as well
         deadline = time.monotonic() + 10.0
         while first.supervisor.rearm_pending or second.supervisor.rearm_pending:
             assert time.monotonic() < deadline, "the canary was never armed again"
-            first.poller.poll_once()
-            second.poller.poll_once()
+            first.poll()
+            second.poll()
         for _ in range(5):
-            first.poller.poll_once()
-            second.poller.poll_once()
+            first.poll()
+            second.poll()
         assert first.names().count("controllerRestarted") == 1
         assert second.names().count("controllerRestarted") == 1
         assert len(sim.writes_to(CANARY_REG)) <= 4  # each wrote at most once after the restart

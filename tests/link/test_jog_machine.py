@@ -45,7 +45,7 @@ def test_silence_drops_the_jog_and_ratio_zero_goes_out_first_on_return(host: Par
     host.jog.press(_press())
     assert sim.wait_for(lambda s: s.jogging)
     sim.set_silent(True)
-    host.poller.poll_once()
+    host.poll()
     assert host.states()[-1] is LinkState.NOT_ANSWERING
     assert host.jog.jog is None
     assert any("jog stopped" in e.message for e in host.of("errorOccurred"))
@@ -71,6 +71,6 @@ def test_idle_teach_is_disabled_after_the_idle_time(
     host.connect(sim)
     host.jog.press(_press())
     host.jog.release()
-    host.poller.poll_once()
+    host.poll()
     assert not sim.state().teach_enabled
     assert [v for _, v in register_writes(sim, 440)] == [0x80, 0x81]

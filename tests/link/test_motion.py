@@ -6,7 +6,7 @@ import pytest
 
 from app import timing
 from app.errors import Reason
-from app.link.motion import MotionTracker
+from app.link.active import MotionTracker
 from app.link.outcome import Outcome, outcome_of
 from app.link.types import Operation
 from app.link.watch import MotionWatch
@@ -155,7 +155,9 @@ def test_motion_commands_start_without_waiting_and_refuse_a_second_motion(sim: o
     host = PartsHost()
     try:
         host.connect(sim)
-        commands = MotionCommands(host)
+        commands = MotionCommands(
+            host, host.motion, host.jog, host.poller, uploading=lambda: host.uploader.run is not None
+        )
         host.request_id = 4
         commands.step(Step(StepFrame.JOINT, [2.0, 0, 0, 0, 0, 0], (0.0,) * 5, 1.0))  # about 0.33 s
         assert host.motion.active is not None and host.motion.active.request_id == 4

@@ -26,7 +26,7 @@ def test_status_is_read_before_the_pose(host: PartsHost, sim: Any, monkeypatch: 
             return _original(*args, **kwargs)
 
         monkeypatch.setattr(client, name, spy)
-    host.poller.poll_once()
+    host.poll()
     assert reads == ["read_status", "read_pose"]
 
 
@@ -40,7 +40,7 @@ def test_a_poll_publishes_pose_status_then_freshness_then_the_result(host: Parts
     host.motion.track(Operation.STEP, tracker, motion=True, request_id=5)
     host.out.clear()
     while host.motion.active is not None:
-        host.poller.poll_once()
+        host.poll()
     names = [
         n for n in host.names() if n in ("poseChanged", "statusChanged", "pollSucceeded", "commandFinished")
     ]
@@ -57,11 +57,11 @@ def test_one_silent_poll_is_not_answering_and_an_answer_is_connected_again(host:
     host.connect(sim, poll_timeout=0.3)
     host.out.clear()
     sim.set_silent(True)
-    host.poller.poll_once()
+    host.poll()
     assert host.states() == [LinkState.NOT_ANSWERING]
     assert host.link_up  # not torn down on the first miss
     assert host.of("errorOccurred")[0].operation == Operation.POLL
-    host.poller.poll_once()
+    host.poll()
     assert host.states() == [LinkState.NOT_ANSWERING]  # shown once
     sim.set_silent(False)
     host.poll_until_answered()
@@ -76,7 +76,7 @@ def test_silence_that_lasts_takes_the_link_down(
     host.connect(sim, poll_timeout=0.06)
     sim.set_silent(True)
     for _ in range(4):
-        host.poller.poll_once()
+        host.poll()
     assert LinkState.DOWN in host.states() and not host.link_up and not host.polling
     assert host.reconnect_delays  # retrying by itself
 
@@ -87,7 +87,7 @@ def test_poll_uses_the_poll_timeout_not_the_command_timeout(host: PartsHost, sim
     import time
 
     t0 = time.monotonic()
-    host.poller.poll_once()
+    host.poll()
     assert time.monotonic() - t0 < 1.5  # 0.05 s (plus load), not the 2 s command timeout
     sim.set_silent(False)
 
@@ -98,7 +98,7 @@ def test_link_stats_reported_at_most_once_a_period(
     monkeypatch.setattr(timing, "RTT_REPORT_PERIOD", 3600.0)
     host.connect(sim)
     for _ in range(5):
-        host.poller.poll_once()
+        host.poll()
     stats = host.of("linkStatsChanged")
     assert len(stats) == 1 and stats[0].answers > 0
     assert isinstance(host.client, RobotClient)

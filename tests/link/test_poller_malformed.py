@@ -108,11 +108,11 @@ def test_a_malformed_poll_answer_is_a_failed_poll(host: PartsHost, sim: Any, pro
     host.connect(sim, port=proxy.port)
     client = host.client
     assert client is not None
-    host.poller.poll_once()
+    host.poll()
     host.out.clear()
     before = client.stats.malformed
     proxy.garble = 1
-    host.poller.poll_once()  # the status read comes back short
+    host.poll()  # the status read comes back short
     assert proxy.garbled == 1
     assert client.stats.malformed == before + 1  # counted by the transport
     names = host.names()
@@ -122,7 +122,7 @@ def test_a_malformed_poll_answer_is_a_failed_poll(host: PartsHost, sim: Any, pro
     assert "malformed answer" in errors[0].message
     assert host.link_up  # one garbled answer is not a lost link
     host.out.clear()
-    host.poller.poll_once()  # the transport reopened the link: the next poll is good
+    host.poll()  # the transport reopened the link: the next poll is good
     assert "pollSucceeded" in host.names()
 
 
@@ -133,6 +133,6 @@ def test_malformed_answers_in_a_row_take_the_link_down(
     host.out.clear()
     proxy.garble = 100
     for _ in range(timing.LINK_LOSS_POLLS):
-        host.poller.poll_once()
+        host.poll()
     assert not host.link_up and LinkState.DOWN in host.states()
     assert "pollSucceeded" not in host.names() and "poseChanged" not in host.names()

@@ -7,6 +7,8 @@ from typing import Any
 import pytest
 
 from app import timing
+from app.link.active import MotionTracker
+from app.link.capture import TrafficCapture
 from app.link.supervisor import LinkSupervisor, check_canary_gv
 from app.link.types import ControllerIdentity, LinkState
 from tests.link.harness import PartsHost
@@ -72,7 +74,7 @@ def test_the_canary_must_be_a_spare_gv() -> None:
     with pytest.raises(ValueError, match=r"GV0\.\.GV5"):
         check_canary_gv(3)
     with pytest.raises(ValueError):
-        LinkSupervisor(PartsHost(), 2)
+        LinkSupervisor(PartsHost(), 2, tracker=MotionTracker(), capture=TrafficCapture())
 
 
 # --- which controller, which boot (issue 18) -----------------------------------------------------
