@@ -16,7 +16,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from PySide6.QtCore import QEvent, QObject, Slot
+from PySide6.QtCore import QEvent, QObject, Qt, Slot
 from PySide6.QtGui import QAction
 
 from app.cell.cell_file import Cell, CellFileError, load_cell
@@ -67,6 +67,7 @@ class CellHost(QObject):
         panel = CellPanel(cell, self.window.work_tabs, **panel_options)
         panel.takeControl.connect(self.take_control)
         panel.exportHistory.connect(self.export_history)
+        panel.ownWindow.connect(self.set_own_window)
         self.panel = panel
         tabs = self.window.work_tabs
         tabs.setCurrentIndex(tabs.addTab(panel, self.tr("Cell")))
@@ -78,11 +79,28 @@ class CellHost(QObject):
         if panel is None:
             return
         panel.stop()
+        panel.window_button.setChecked(False)  # back in its tab, to leave it
         tabs = self.window.work_tabs
         index = tabs.indexOf(panel)
         if index >= 0:
             tabs.removeTab(index)
         panel.deleteLater()
+
+    @Slot(bool)
+    def set_own_window(self, own: bool) -> None:
+        """The Cell tab in a window of its own (the window's size: 16 tiles at 1280×800), or back."""
+        panel, tabs = self.panel, self.window.work_tabs
+        if panel is None or own == panel.isWindow():
+            return
+        if own:
+            tabs.removeTab(tabs.indexOf(panel))
+            panel.setParent(self.window, Qt.WindowType.Window)
+            panel.setWindowTitle(self.tr("Cell {name}").format(name=panel.cell.name))
+            panel.resize(self.window.size())
+            panel.show()
+        else:
+            panel.setParent(None)
+            tabs.setCurrentIndex(tabs.addTab(panel, self.tr("Cell")))
 
     # --- monitor many, command one -------------------------------------------------------
     @Slot(str)
@@ -138,6 +156,7 @@ class CellHost(QObject):
             index = self.window.work_tabs.indexOf(self.panel)
             if index >= 0:
                 self.window.work_tabs.setTabText(index, self.tr("Cell"))
+            self.panel.setWindowTitle(self.tr("Cell {name}").format(name=self.panel.cell.name))
 
     def eventFilter(self, watched: QObject, event: QEvent) -> bool:
         if watched is self.window:

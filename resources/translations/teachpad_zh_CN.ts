@@ -638,13 +638,19 @@
             <translation>单元文件</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="72" />
-            <location filename="../../ui/window_cell.py" line="140" />
+            <location filename="../../ui/window_cell.py" line="73" />
+            <location filename="../../ui/window_cell.py" line="103" />
+            <location filename="../../ui/window_cell.py" line="158" />
             <source>Cell</source>
             <translation>单元</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="101" />
+            <location filename="../../ui/window_cell.py" line="98" />
+            <source>Cell {name}</source>
+            <translation>单元 {name}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_cell.py" line="119" />
             <source>Take control of {name} ({where})?
 
 The pendant connects to it and commands it; every other robot of the cell stays monitor-only.</source>
@@ -653,33 +659,33 @@ The pendant connects to it and commands it; every other robot of the cell stays 
 示教器将连接并控制它；单元中其他机器人保持仅监视。</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="104" />
+            <location filename="../../ui/window_cell.py" line="122" />
             <source>Take control</source>
             <translation>接管控制</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="122" />
-            <location filename="../../ui/window_cell.py" line="129" />
+            <location filename="../../ui/window_cell.py" line="140" />
+            <location filename="../../ui/window_cell.py" line="147" />
             <source>Export history</source>
             <translation>导出历史</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="122" />
+            <location filename="../../ui/window_cell.py" line="140" />
             <source>CSV files (*.csv)</source>
             <translation>CSV 文件 (*.csv)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="129" />
+            <location filename="../../ui/window_cell.py" line="147" />
             <source>Cannot write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="135" />
+            <location filename="../../ui/window_cell.py" line="153" />
             <source>Open &amp;cell…</source>
             <translation>打开单元(&amp;C)…</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="136" />
+            <location filename="../../ui/window_cell.py" line="154" />
             <source>Watch every controller of a cell file, monitor only</source>
             <translation>监视单元文件中的每台控制器（仅监视）</translation>
         </message>
@@ -687,37 +693,47 @@ The pendant connects to it and commands it; every other robot of the cell stays 
     <context>
         <name>CellPanel</name>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="349" />
+            <location filename="../../ui/panels/cell_panel.py" line="378" />
             <source>History of {name}</source>
             <translation>{name} 的历史</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="357" />
+            <location filename="../../ui/panels/cell_panel.py" line="386" />
             <source>Cell {name}: {count} controllers, monitor only</source>
             <translation>单元 {name}：{count} 台控制器，仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="360" />
+            <location filename="../../ui/panels/cell_panel.py" line="389" />
             <source>Back to the cell</source>
             <translation>返回单元</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="361" />
+            <location filename="../../ui/panels/cell_panel.py" line="390" />
+            <source>Whole window</source>
+            <translation>整个窗口</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="391" />
+            <source>Show the cell in a window of its own (16 tiles at a glance)</source>
+            <translation>在单独窗口中显示单元（一眼看到 16 个磁贴）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="392" />
             <source>Export CSV…</source>
             <translation>导出 CSV…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="362" />
+            <location filename="../../ui/panels/cell_panel.py" line="393" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="362" />
+            <location filename="../../ui/panels/cell_panel.py" line="393" />
             <source>Event</source>
             <translation>事件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="362" />
+            <location filename="../../ui/panels/cell_panel.py" line="393" />
             <source>Detail</source>
             <translation>详情</translation>
         </message>
@@ -725,52 +741,52 @@ The pendant connects to it and commands it; every other robot of the cell stays 
     <context>
         <name>CellTile</name>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="165" />
+            <location filename="../../ui/panels/cell_panel.py" line="166" />
             <source>{name} (in control)</source>
             <translation>{name}（控制中）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="168" />
+            <location filename="../../ui/panels/cell_panel.py" line="169" />
             <source>not answering {seconds} s</source>
             <translation>无应答 {seconds} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="170" />
+            <location filename="../../ui/panels/cell_panel.py" line="171" />
             <source>answering</source>
             <translation>正在应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="174" />
-            <source>no answer yet; {errors} errors in the last minute</source>
-            <translation>尚无应答；最近一分钟 {errors} 次错误</translation>
+            <location filename="../../ui/panels/cell_panel.py" line="175" />
+            <source>no answer yet, {errors} errors/min</source>
+            <translation>尚无应答，{errors} 次错误/分钟</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="177" />
-            <source>answer {age} s ago, RTT {rtt} ms, {errors} errors in the last minute</source>
-            <translation>{age} 秒前应答，往返 {rtt} 毫秒，最近一分钟 {errors} 次错误</translation>
+            <location filename="../../ui/panels/cell_panel.py" line="178" />
+            <source>{age} s ago, RTT {rtt} ms, {errors} errors/min</source>
+            <translation>{age} 秒前，往返 {rtt} 毫秒，{errors} 次错误/分钟</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="202" />
+            <location filename="../../ui/panels/cell_panel.py" line="203" />
             <source>mode {mode}, program {program}</source>
             <translation>模式 {mode}，程序 {program}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="210" />
+            <location filename="../../ui/panels/cell_panel.py" line="211" />
             <source>alarms: {alarms}</source>
             <translation>报警：{alarms}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="212" />
+            <location filename="../../ui/panels/cell_panel.py" line="213" />
             <source>no alarm</source>
             <translation>无报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="219" />
+            <location filename="../../ui/panels/cell_panel.py" line="220" />
             <source>Take control…</source>
             <translation>接管控制…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="220" />
+            <location filename="../../ui/panels/cell_panel.py" line="221" />
             <source>History</source>
             <translation>历史</translation>
         </message>

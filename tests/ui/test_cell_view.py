@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from PySide6.QtCore import QCoreApplication
 
 from app.cell.cell_file import Cell, CellController, save_cell
 from app.gateway.poller import GatewayTiming
@@ -60,6 +61,13 @@ def _open(window: Any, project_dialogs: Any, path: Path) -> CellPanel:
     return panel
 
 
+def _laid_out() -> None:
+    """Deliver the posted layout requests (texts just changed), no waiting on anything else."""
+    for _ in range(3):
+        QCoreApplication.sendPostedEvents()
+        QCoreApplication.processEvents()
+
+
 def _answering(tile: CellTile) -> bool:
     return tile.reading is not None and not tile.silent
 
@@ -101,7 +109,7 @@ def test_a_silent_controller_greys_while_the_others_keep_updating(
     greyed_after = time.monotonic() - silenced
     # within its poll timeout (and a poll period, and the queued signal), not the others' business
     assert greyed_after < TIMING.poll_timeout + 1 / TIMING.poll_hz + 1.5
-    assert not tiles["R2"].link_label.isEnabled()
+    assert tiles["R2"].property("silent") and not tiles["R2"].state_label.isEnabled()
     qtbot.waitUntil(lambda: tiles["R2"].link_label.text() == "not answering 2 s", timeout=WAIT_MS)
     # the others keep answering: fresh answers, well after the silence began
     since = time.monotonic()
@@ -212,6 +220,7 @@ def test_a_bad_cell_file_is_one_line_in_a_dialog(qtbot: Any, window: Any, projec
     assert "R2" in text and "port" in text and "\n" not in text
 
 
+@pytest.mark.qt_log_ignore(*QT_LOG_IGNORE, "This plugin does not support setParent")  # offscreen's, going back
 @pytest.mark.parametrize("language", ["en", "zh_CN"])
 def test_sixteen_tiles_fit_1280x800(
     qtbot: Any, window: Any, project_dialogs: Any, sim_factory: Any, translator: Any, tmp_path: Path, language: str
@@ -224,17 +233,33 @@ def test_sixteen_tiles_fit_1280x800(
         assert translator.set_language(language)
         window.set_language(language)
     window.resize(1280, 800)
+    qtbot.waitUntil(lambda: window.size().toTuple() == (1280, 800), timeout=WAIT_MS)
     panel = _open(window, project_dialogs, _cell(sims, tmp_path))
     try:
         qtbot.waitUntil(lambda: sum(_answering(t) for t in panel.tiles.values()) == 15, timeout=WAIT_MS * 2)
         qtbot.waitUntil(lambda: panel.tiles["R6"].silent, timeout=WAIT_MS)
+        # in the tab beside the pendant's controls: reflowed to its width, nothing cut, no overlap
         panel.refresh()
-        qtbot.wait(50)  # a layout pass (not a wait for the network)
+        _laid_out()
         assert clipped_texts(panel) == []
         assert overlapping_siblings(panel) == []
-        host = panel.scroll.widget()
-        area = panel.scroll.viewport().rect()
-        assert all(area.contains(t.geometry().translated(-host.pos() * 0)) for t in panel.tiles.values())
-        assert panel.scroll.verticalScrollBar().maximum() == 0, "16 tiles on one screen"
+        # in a window of its own at 1280×800: all 16 at a glance
+        panel.window_button.click()
+        assert panel.isWindow() and panel.size().toTuple() == (1280, 800)
+        qtbot.waitExposed(panel)
+        panel.refresh()
+        _laid_out()
+        bars = (panel.scroll.verticalScrollBar(), panel.scroll.horizontalScrollBar())
+        qtbot.waitUntil(lambda: all(bar.maximum() == 0 for bar in bars), timeout=WAIT_MS)  # layout passes
+        assert clipped_texts(panel) == []
+        assert overlapping_siblings(panel) == []
+        assert overlapping_siblings(panel.scroll.widget()) == []
+        view = panel.scroll.viewport()
+        for tile in panel.tiles.values():
+            corner = tile.mapTo(view, tile.rect().bottomRight())
+            assert view.rect().contains(corner), f"{tile.name} is out of sight"
+        assert panel.tiles["R6"].link_label.text().startswith("not answering" if language == "en" else "无应答")
+        panel.close()  # back in its tab
+        assert not panel.isWindow() and window.work_tabs.indexOf(panel) >= 0
     finally:
         window.cell.close_cell()

@@ -20,6 +20,7 @@ import collections
 import time
 
 from PySide6.QtCore import QCoreApplication, QEvent, QObject, Qt, QTimer, Signal, Slot
+from PySide6.QtGui import QCloseEvent, QResizeEvent
 from PySide6.QtWidgets import (
     QFrame,
     QGridLayout,
@@ -45,7 +46,10 @@ __all__ = ["CELL_POLL_HZ", "CellFeed", "CellPanel", "CellTile"]
 CELL_POLL_HZ = 5.0  # polls per controller per s in the GUI (the gateway's own rate is app.timing's)
 STALE_AFTER = 1.0  # s without an answer: the tile greys
 ERROR_WINDOW = 60.0  # s: "errors in the last minute"
-COLUMNS = 4
+SILENT_STYLE = "QFrame#CellTile { background-color: #d4d4d4; }"
+SILENT_TEXT_STYLE = "color: #6a0000; font-weight: bold;"
+ALARM_STYLE = "color: #b00000;"
+TILE_WIDTH = 200  # px: as many columns as fit the tab
 
 
 def _protocol(text: str) -> str:
@@ -171,18 +175,20 @@ class CellTile(QFrame):
         self._show_reading()
         errors = self.errors_last_minute()
         if self.reading is None:
-            self.fresh_label.setText(self.tr("no answer yet; {errors} errors in the last minute").format(errors=errors))
+            self.fresh_label.setText(self.tr("no answer yet, {errors} errors/min").format(errors=errors))
         else:
             self.fresh_label.setText(
-                self.tr("answer {age} s ago, RTT {rtt} ms, {errors} errors in the last minute").format(
+                self.tr("{age} s ago, RTT {rtt} ms, {errors} errors/min").format(
                     age=f"{age:.1f}", rtt=f"{self.reading.rtt_ms:.0f}", errors=errors
                 )
             )
         if silent != self.silent:
             self.silent = silent
             self.setProperty("silent", silent)
+            self.setStyleSheet(SILENT_STYLE if silent else "")  # greyed at a glance
             for child in self.findChildren(QLabel):
-                child.setEnabled(not silent)
+                child.setEnabled(not silent or child is self.link_label)
+            self.link_label.setStyleSheet(SILENT_TEXT_STYLE if silent else "")
         self.control_button.setEnabled(not self.controlled)
 
     def _show_reading(self) -> None:
@@ -210,6 +216,7 @@ class CellTile(QFrame):
             self.alarm_label.setText(self.tr("alarms: {alarms}").format(alarms=names))
         else:
             self.alarm_label.setText(self.tr("no alarm"))
+        self.alarm_label.setStyleSheet(ALARM_STYLE if alarms else "")
         pose = reading.pose
         self.pose_label.setText(
             f"X {pose.x:.1f}  Y {pose.y:.1f}  Z {pose.z:.1f}\nA {pose.a:.1f}  B {pose.b:.1f}  C {pose.c:.1f}"
@@ -226,6 +233,7 @@ class CellPanel(QWidget):
 
     takeControl = Signal(str)
     exportHistory = Signal(str)  # controller name: the host asks where and writes
+    ownWindow = Signal(bool)  # the whole-window button: True to leave the tab, False to come back
 
     def __init__(
         self,
@@ -248,21 +256,27 @@ class CellPanel(QWidget):
         outer.setContentsMargins(0, 0, 0, 0)
         self.title = QLabel(self)
         self.title.setTextFormat(Qt.TextFormat.PlainText)
-        outer.addWidget(self.title)
+        self.window_button = QPushButton(self)
+        self.window_button.setCheckable(True)
+        self.window_button.toggled.connect(self.ownWindow)
+        top = QHBoxLayout()
+        top.addWidget(self.title, 1)
+        top.addWidget(self.window_button)
+        outer.addLayout(top)
         outer.addWidget(self.pages, 1)
         self.scroll = QScrollArea(self)
         self.scroll.setWidgetResizable(True)
         grid_host = QWidget(self.scroll)
-        grid = QGridLayout(grid_host)
-        grid.setContentsMargins(2, 2, 2, 2)
-        grid.setSpacing(4)
-        for i, controller in enumerate(cell.controllers):
+        self.grid = QGridLayout(grid_host)
+        self.grid.setContentsMargins(2, 2, 2, 2)
+        self.grid.setSpacing(4)
+        self.columns = 0
+        for controller in cell.controllers:
             tile = CellTile(controller, grid_host)
             tile.takeControl.connect(self.takeControl)
             tile.showHistory.connect(self.show_history)
-            grid.addWidget(tile, i // COLUMNS, i % COLUMNS)
             self.tiles[controller.name] = tile
-        grid.setRowStretch(len(cell.controllers) // COLUMNS + 1, 1)
+        self._reflow(4)
         self.scroll.setWidget(grid_host)
         self.pages.addWidget(self.scroll)
         self.detail = self._make_detail()
@@ -296,6 +310,27 @@ class CellPanel(QWidget):
         self.table.setEditTriggers(QTableWidget.EditTrigger.NoEditTriggers)
         layout.addWidget(self.table, 1)
         return page
+
+    def _reflow(self, columns: int) -> None:
+        """Lay the tiles out in ``columns`` columns (the tab's width decides: :meth:`resizeEvent`)."""
+        columns = max(1, columns)
+        if columns == self.columns:
+            return
+        self.columns = columns
+        for tile in self.tiles.values():
+            self.grid.removeWidget(tile)
+        for i, tile in enumerate(self.tiles.values()):
+            self.grid.addWidget(tile, i // columns, i % columns)
+        for column in range(len(self.tiles)):
+            self.grid.setColumnStretch(column, 1 if column < columns else 0)
+        rows = -(-len(self.tiles) // columns)
+        for row in range(self.grid.rowCount()):
+            self.grid.setRowStretch(row, 0)
+        self.grid.setRowStretch(rows, 1)
+
+    def resizeEvent(self, event: QResizeEvent) -> None:
+        super().resizeEvent(event)
+        self._reflow((event.size().width() - 24) // TILE_WIDTH)  # the scroll bar and margins
 
     # --- life --------------------------------------------------------------------------
     def start(self) -> None:
@@ -358,10 +393,20 @@ class CellPanel(QWidget):
             name=self.cell.name, count=len(self.tiles)
         ))
         self.back_button.setText(self.tr("Back to the cell"))
+        self.window_button.setText(self.tr("Whole window"))
+        self.window_button.setToolTip(self.tr("Show the cell in a window of its own (16 tiles at a glance)"))
         self.export_button.setText(self.tr("Export CSV…"))
         self.table.setHorizontalHeaderLabels([self.tr("Time"), self.tr("Event"), self.tr("Detail")])
         for tile in self.tiles.values():
             tile.retranslate()
+
+    def closeEvent(self, event: QCloseEvent) -> None:
+        """In a window of its own, closing it puts the cell back in its tab (the host's)."""
+        if self.isWindow() and self.window_button.isChecked():
+            event.ignore()
+            self.window_button.setChecked(False)
+            return
+        super().closeEvent(event)
 
     def changeEvent(self, event: QEvent) -> None:
         if event.type() == QEvent.Type.LanguageChange:
