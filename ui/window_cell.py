@@ -144,9 +144,12 @@ class CellHost(QObject):
         try:
             tile.history.export_csv(path)
         except (OSError, TeachPadError) as exc:
-            dialogs.error(self.tr("Export history"), self.tr("Cannot write {path}: {error}").format(
-                path=path, error=getattr(exc, "strerror", None) or str(exc)
-            ))
+            dialogs.error(
+                self.tr("Export history"),
+                self.tr("Cannot write {path}: {error}").format(
+                    path=path, error=getattr(exc, "strerror", None) or str(exc)
+                ),
+            )
 
     # --- the window --------------------------------------------------------------------
     def retranslate(self) -> None:

@@ -99,7 +99,9 @@ class ControllerHistory:
             self._add(wall_ms, "state", f"program {_name(int(status.program_state), ProgramState)}")
             return
         if int(last.mode) != int(status.mode):
-            self._add(wall_ms, "state", f"mode {_mode_name(int(last.mode))} -> {_mode_name(int(status.mode))}")
+            self._add(
+                wall_ms, "state", f"mode {_mode_name(int(last.mode))} -> {_mode_name(int(status.mode))}"
+            )
         self._program(int(last.program_state), int(status.program_state), int(status.alarms), wall_ms)
 
     def silent(self, reason: str, wall_ms: int) -> None:
@@ -126,7 +128,9 @@ class ControllerHistory:
         elif now == stopped and before == running and not alarms:
             self._add(wall_ms, "program finished", "")
         elif now == stopped:
-            self._add(wall_ms, "program stopped", "alarm" if alarms else f"from {_name(before, ProgramState)}")
+            self._add(
+                wall_ms, "program stopped", "alarm" if alarms else f"from {_name(before, ProgramState)}"
+            )
         else:
             detail = f"program {_name(before, ProgramState)} -> {_name(now, ProgramState)}"
             self._add(wall_ms, "state", detail)

@@ -84,7 +84,9 @@ def panel_fixture(window: Any, project_dialogs: Any, sims: list[Any], tmp_path: 
     window.cell.close_cell()
 
 
-def test_open_cell_shows_a_tile_per_controller_each_with_its_own_poller(qtbot: Any, window: Any, panel: Any) -> None:
+def test_open_cell_shows_a_tile_per_controller_each_with_its_own_poller(
+    qtbot: Any, window: Any, panel: Any
+) -> None:
     assert window.work_tabs.tabText(window.work_tabs.currentIndex()) == "Cell"
     assert list(panel.tiles) == ["R1", "R2", "R3"]
     qtbot.waitUntil(lambda: all(_answering(t) for t in panel.tiles.values()), timeout=WAIT_MS)
@@ -164,7 +166,10 @@ def test_alarms_most_severe_first_then_oldest_and_history_csv(
     assert ("link", "answering") in events
     raised = [e for e in events if e[0] == "alarm raised"]
     assert raised == [("alarm raised", "encoder angle alarm"), ("alarm raised", "servo alarm")]
-    assert [e for e in events if e[0] == "alarm cleared"] == [("alarm cleared", "servo alarm"), ("alarm cleared", "encoder angle alarm")]
+    assert [e for e in events if e[0] == "alarm cleared"] == [
+        ("alarm cleared", "servo alarm"),
+        ("alarm cleared", "encoder angle alarm"),
+    ]
     assert not list(tmp_path.glob("*.tmp*"))
 
 
@@ -206,7 +211,9 @@ def test_take_control_connects_the_window_to_that_robot_after_a_confirmation(
     assert not panel.tiles["R2"].controlled and panel.tiles["R3"].controlled
 
 
-def test_a_bad_cell_file_is_one_line_in_a_dialog(qtbot: Any, window: Any, project_dialogs: Any, tmp_path: Path) -> None:
+def test_a_bad_cell_file_is_one_line_in_a_dialog(
+    qtbot: Any, window: Any, project_dialogs: Any, tmp_path: Path
+) -> None:
     path = tmp_path / "bad.json"
     path.write_text(
         '{"format": "teachpad-cell", "version": 1, "name": "c", "controllers": '
@@ -216,14 +223,22 @@ def test_a_bad_cell_file_is_one_line_in_a_dialog(qtbot: Any, window: Any, projec
     project_dialogs.open_answer = str(path)
     window.cell.open_action.trigger()
     assert window.cell.panel is None
-    (title, text), = project_dialogs.errors
+    ((_title, text),) = project_dialogs.errors
     assert "R2" in text and "port" in text and "\n" not in text
 
 
-@pytest.mark.qt_log_ignore(*QT_LOG_IGNORE, "This plugin does not support setParent")  # offscreen's, going back
+@pytest.mark.qt_log_ignore(
+    *QT_LOG_IGNORE, "This plugin does not support setParent"
+)  # offscreen's, going back
 @pytest.mark.parametrize("language", ["en", "zh_CN"])
 def test_sixteen_tiles_fit_1280x800(
-    qtbot: Any, window: Any, project_dialogs: Any, sim_factory: Any, translator: Any, tmp_path: Path, language: str
+    qtbot: Any,
+    window: Any,
+    project_dialogs: Any,
+    sim_factory: Any,
+    translator: Any,
+    tmp_path: Path,
+    language: str,
 ) -> None:
     sims = [sim_factory() for _ in range(16)]
     for sim in sims[::3]:
@@ -258,7 +273,9 @@ def test_sixteen_tiles_fit_1280x800(
         for tile in panel.tiles.values():
             corner = tile.mapTo(view, tile.rect().bottomRight())
             assert view.rect().contains(corner), f"{tile.name} is out of sight"
-        assert panel.tiles["R6"].link_label.text().startswith("not answering" if language == "en" else "无应答")
+        assert (
+            panel.tiles["R6"].link_label.text().startswith("not answering" if language == "en" else "无应答")
+        )
         panel.close()  # back in its tab
         assert not panel.isWindow() and window.work_tabs.indexOf(panel) >= 0
     finally:

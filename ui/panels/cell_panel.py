@@ -39,7 +39,13 @@ from app.cell.cell_file import Cell, CellController
 from app.cell.history import ControllerHistory, alarm_order
 from app.gateway.metrics import Reading
 from app.gateway.poller import ControllerPoller, GatewayTiming
-from app.protocol.enums import ALARM_TEXT, CONTROLLER_MODE_TEXT, PROGRAM_STATE_TEXT, ControllerMode, ProgramState
+from app.protocol.enums import (
+    ALARM_TEXT,
+    CONTROLLER_MODE_TEXT,
+    PROGRAM_STATE_TEXT,
+    ControllerMode,
+    ProgramState,
+)
 
 __all__ = ["CELL_POLL_HZ", "CellFeed", "CellPanel", "CellTile"]
 
@@ -198,7 +204,11 @@ class CellTile(QFrame):
                 label.setText("—")
             return
         status = reading.status
-        mode = CONTROLLER_MODE_TEXT.get(ControllerMode(status.mode)) if status.mode in set(ControllerMode) else None
+        mode = (
+            CONTROLLER_MODE_TEXT.get(ControllerMode(status.mode))
+            if status.mode in set(ControllerMode)
+            else None
+        )
         program = (
             PROGRAM_STATE_TEXT.get(ProgramState(status.program_state))
             if status.program_state in set(ProgramState)
@@ -389,9 +399,11 @@ class CellPanel(QWidget):
                 self.table.setItem(row, column, QTableWidgetItem(text))
 
     def retranslate(self) -> None:
-        self.title.setText(self.tr("Cell {name}: {count} controllers, monitor only").format(
-            name=self.cell.name, count=len(self.tiles)
-        ))
+        self.title.setText(
+            self.tr("Cell {name}: {count} controllers, monitor only").format(
+                name=self.cell.name, count=len(self.tiles)
+            )
+        )
         self.back_button.setText(self.tr("Back to the cell"))
         self.window_button.setText(self.tr("Whole window"))
         self.window_button.setToolTip(self.tr("Show the cell in a window of its own (16 tiles at a glance)"))
@@ -412,4 +424,3 @@ class CellPanel(QWidget):
         if event.type() == QEvent.Type.LanguageChange:
             self.retranslate()
         super().changeEvent(event)
-
