@@ -35,7 +35,8 @@ from ui.panels.cell_panel import CellPanel, CellTile
 pytestmark = [pytest.mark.timeout(120), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
 
 # roomy: the simulators run in the test process on a loaded machine
-TIMING = GatewayTiming(poll_hz=5.0, poll_timeout=0.5, backoff=(0.2, 0.5))
+POLL_TIMEOUT = 0.5  # s
+TIMING = GatewayTiming(poll_hz=5.0, poll_timeout=POLL_TIMEOUT, backoff=(0.2, 0.5))
 STALE_AFTER = 1.5  # s
 WAIT_MS = 10_000
 
@@ -56,7 +57,7 @@ def _open(window: Any, project_dialogs: Any, path: Path) -> CellPanel:
     host.show_cell = lambda cell: original(cell, timing=TIMING, stale_after=STALE_AFTER)
     window.cell.open_action.trigger()
     assert project_dialogs.asked[-1] == "open"
-    panel = host.panel
+    panel: CellPanel | None = host.panel
     assert panel is not None
     return panel
 
@@ -110,7 +111,7 @@ def test_a_silent_controller_greys_while_the_others_keep_updating(
     qtbot.waitUntil(lambda: tiles["R2"].silent, timeout=WAIT_MS)
     greyed_after = time.monotonic() - silenced
     # within its poll timeout (and a poll period, and the queued signal), not the others' business
-    assert greyed_after < TIMING.poll_timeout + 1 / TIMING.poll_hz + 1.5
+    assert greyed_after < POLL_TIMEOUT + 1 / TIMING.poll_hz + 1.5
     assert tiles["R2"].property("silent") and not tiles["R2"].state_label.isEnabled()
     qtbot.waitUntil(lambda: tiles["R2"].link_label.text() == "not answering 2 s", timeout=WAIT_MS)
     # the others keep answering: fresh answers, well after the silence began
@@ -181,11 +182,19 @@ def test_take_control_connects_the_window_to_that_robot_after_a_confirmation(
     before = [sim.connections_count for sim in sims]
     assert before == [1, 1, 1]  # the pollers only
     asked: list[tuple[str, str]] = []
-    window.confirm = lambda title, text: asked.append((title, text)) is not None  # "no"
+
+    def answer(yes: bool) -> Any:
+        def confirm(title: str, text: str) -> bool:
+            asked.append((title, text))
+            return yes
+
+        return confirm
+
+    window.confirm = answer(False)
     panel.tiles["R2"].control_button.click()
     assert len(asked) == 1 and "R2" in asked[0][1] and f"127.0.0.1:{sims[1].port}" in asked[0][1]
     assert window.link.state.connection.state is LinkState.DISCONNECTED
-    window.confirm = lambda title, text: asked.append((title, text)) is None  # "yes"
+    window.confirm = answer(True)
     with qtbot.waitSignal(
         window.link.connectionChanged, check_params_cb=is_state(LinkState.CONNECTED), timeout=WAIT_MS
     ):
@@ -264,12 +273,13 @@ def test_sixteen_tiles_fit_1280x800(
         qtbot.waitExposed(panel)
         panel.refresh()
         _laid_out()
-        bars = (panel.scroll.verticalScrollBar(), panel.scroll.horizontalScrollBar())
+        bars = (panel.area.verticalScrollBar(), panel.area.horizontalScrollBar())
         qtbot.waitUntil(lambda: all(bar.maximum() == 0 for bar in bars), timeout=WAIT_MS)  # layout passes
         assert clipped_texts(panel) == []
         assert overlapping_siblings(panel) == []
-        assert overlapping_siblings(panel.scroll.widget()) == []
-        view = panel.scroll.viewport()
+        grid_host = panel.area.widget()
+        assert grid_host is not None and overlapping_siblings(grid_host) == []
+        view = panel.area.viewport()
         for tile in panel.tiles.values():
             corner = tile.mapTo(view, tile.rect().bottomRight())
             assert view.rect().contains(corner), f"{tile.name} is out of sight"

@@ -274,9 +274,9 @@ class CellPanel(QWidget):
         top.addWidget(self.window_button)
         outer.addLayout(top)
         outer.addWidget(self.pages, 1)
-        self.scroll = QScrollArea(self)
-        self.scroll.setWidgetResizable(True)
-        grid_host = QWidget(self.scroll)
+        self.area = QScrollArea(self)
+        self.area.setWidgetResizable(True)
+        grid_host = QWidget(self.area)
         self.grid = QGridLayout(grid_host)
         self.grid.setContentsMargins(2, 2, 2, 2)
         self.grid.setSpacing(4)
@@ -287,8 +287,8 @@ class CellPanel(QWidget):
             tile.showHistory.connect(self.show_history)
             self.tiles[controller.name] = tile
         self._reflow(4)
-        self.scroll.setWidget(grid_host)
-        self.pages.addWidget(self.scroll)
+        self.area.setWidget(grid_host)
+        self.pages.addWidget(self.area)
         self.detail = self._make_detail()
         self.pages.addWidget(self.detail)
         self.detail_name: str | None = None
