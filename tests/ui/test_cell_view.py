@@ -5,6 +5,7 @@ languages, and 16 tiles at 1280×800 with no text cut and no tile over another."
 
 from __future__ import annotations
 
+import itertools
 import time
 from pathlib import Path
 from typing import Any
@@ -106,6 +107,8 @@ def test_a_silent_controller_greys_while_the_others_keep_updating(
 ) -> None:
     tiles = panel.tiles
     qtbot.waitUntil(lambda: all(_answering(t) for t in tiles.values()), timeout=WAIT_MS)
+    answers: dict[str, list[float]] = {"R1": [], "R3": []}
+    panel.feed.answered.connect(lambda name, reading: answers.get(name, []).append(reading.answered_at))
     sims[1].set_silent(True)
     silenced = time.monotonic()
     qtbot.waitUntil(lambda: tiles["R2"].silent, timeout=WAIT_MS)
@@ -124,6 +127,12 @@ def test_a_silent_controller_greys_while_the_others_keep_updating(
         assert tiles[name].age() < 1.0
         assert tiles[name].errors_last_minute() == 0
     assert tiles["R2"].errors_last_minute() >= 1
+    # a dead one costs the others nothing: their answers keep the poll period while R2 times out
+    period = 1 / TIMING.poll_hz
+    for name, times in answers.items():
+        gaps = [b - a for a, b in itertools.pairwise(times)]
+        assert len(gaps) >= 5, name
+        assert max(gaps) < 2.5 * period, f"{name}: a gap of {max(gaps):.3f} s (period {period} s)"
     # both languages
     assert translator.set_language("zh_CN")
     window.set_language("zh_CN")
@@ -218,6 +227,15 @@ def test_take_control_connects_the_window_to_that_robot_after_a_confirmation(
     qtbot.waitUntil(lambda: sims[1].connections_count == 1 and sims[2].connections_count > 1, timeout=WAIT_MS)
     assert sims[0].connections_count == 1
     assert not panel.tiles["R2"].controlled and panel.tiles["R3"].controlled
+
+
+def test_closing_the_window_ends_every_poller(qtbot: Any, window: Any, panel: Any) -> None:
+    qtbot.waitUntil(lambda: all(_answering(t) for t in panel.tiles.values()), timeout=WAIT_MS)
+    threads = [poller._thread for poller in panel.pollers]
+    assert all(thread.is_alive() for thread in threads)
+    window.close()
+    assert not any(thread.is_alive() for thread in threads)
+    assert window.cell.panel is None and not panel.timer.isActive()
 
 
 def test_a_bad_cell_file_is_one_line_in_a_dialog(

@@ -46,6 +46,7 @@ from app.protocol.enums import (
     ControllerMode,
     ProgramState,
 )
+from ui.joins import join_names
 
 __all__ = ["CELL_POLL_HZ", "CellFeed", "CellPanel", "CellTile"]
 
@@ -222,7 +223,7 @@ class CellTile(QFrame):
         )
         alarms = alarm_order(int(status.alarms), self.history.raised_at)
         if alarms:
-            names = ", ".join(_protocol(ALARM_TEXT[bit]) for bit in alarms)
+            names = join_names(_protocol(ALARM_TEXT[bit]) for bit in alarms)
             self.alarm_label.setText(self.tr("alarms: {alarms}").format(alarms=names))
         else:
             self.alarm_label.setText(self.tr("no alarm"))
