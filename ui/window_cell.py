@@ -14,15 +14,17 @@ link ever writes; the tiles' clients are monitor-only, so one robot at a time is
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QEvent, QObject, Qt, Slot
 from PySide6.QtGui import QAction
 
-from app.cell.cell_file import Cell, CellFileError, load_cell
 from app.errors import TeachPadError
 from app.safety.roles import Action
-from ui.panels.cell_panel import CellPanel
+
+if TYPE_CHECKING:  # the cell's modules (Modbus clients, pollers) load with the first cell, not at start-up
+    from app.cell.cell_file import Cell
+    from ui.panels.cell_panel import CellPanel
 
 __all__ = ["CellHost", "install_cell"]
 
@@ -54,6 +56,8 @@ class CellHost(QObject):
 
     def open_cell(self, path: str) -> bool:
         """Load the cell file at ``path`` and show its tab; a bad file is said in a dialog."""
+        from app.cell.cell_file import CellFileError, load_cell
+
         try:
             cell = load_cell(path)
         except CellFileError as exc:
@@ -63,6 +67,8 @@ class CellHost(QObject):
         return True
 
     def show_cell(self, cell: Cell, **panel_options: Any) -> CellPanel:
+        from ui.panels.cell_panel import CellPanel
+
         self.close_cell()
         panel = CellPanel(cell, self.window.work_tabs, **panel_options)
         panel.takeControl.connect(self.take_control)
