@@ -623,34 +623,35 @@
     <context>
         <name>CellHost</name>
         <message>
-            <location filename="../../ui/window_cell.py" line="51" />
+            <location filename="../../ui/window_cell.py" line="53" />
             <source>Open cell</source>
             <translation>打开单元</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="51" />
+            <location filename="../../ui/window_cell.py" line="53" />
             <source>Cell files (*.json);;All files (*)</source>
             <translation>单元文件 (*.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="60" />
+            <location filename="../../ui/window_cell.py" line="64" />
             <source>Cell file</source>
             <translation>单元文件</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="73" />
-            <location filename="../../ui/window_cell.py" line="103" />
-            <location filename="../../ui/window_cell.py" line="158" />
+            <location filename="../../ui/window_cell.py" line="79" />
+            <location filename="../../ui/window_cell.py" line="109" />
+            <location filename="../../ui/window_cell.py" line="167" />
             <source>Cell</source>
             <translation>单元</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="98" />
+            <location filename="../../ui/window_cell.py" line="104" />
+            <location filename="../../ui/window_cell.py" line="168" />
             <source>Cell {name}</source>
             <translation>单元 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="119" />
+            <location filename="../../ui/window_cell.py" line="125" />
             <source>Take control of {name} ({where})?
 
 The pendant connects to it and commands it; every other robot of the cell stays monitor-only.</source>
@@ -659,33 +660,33 @@ The pendant connects to it and commands it; every other robot of the cell stays 
 示教器将连接并控制它；单元中其他机器人保持仅监视。</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="122" />
+            <location filename="../../ui/window_cell.py" line="128" />
             <source>Take control</source>
             <translation>接管控制</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="140" />
-            <location filename="../../ui/window_cell.py" line="147" />
+            <location filename="../../ui/window_cell.py" line="146" />
+            <location filename="../../ui/window_cell.py" line="154" />
             <source>Export history</source>
             <translation>导出历史</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="140" />
+            <location filename="../../ui/window_cell.py" line="146" />
             <source>CSV files (*.csv)</source>
             <translation>CSV 文件 (*.csv)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="147" />
+            <location filename="../../ui/window_cell.py" line="155" />
             <source>Cannot write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="153" />
+            <location filename="../../ui/window_cell.py" line="162" />
             <source>Open &amp;cell…</source>
             <translation>打开单元(&amp;C)…</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="154" />
+            <location filename="../../ui/window_cell.py" line="163" />
             <source>Watch every controller of a cell file, monitor only</source>
             <translation>监视单元文件中的每台控制器（仅监视）</translation>
         </message>
@@ -693,47 +694,47 @@ The pendant connects to it and commands it; every other robot of the cell stays 
     <context>
         <name>CellPanel</name>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="378" />
+            <location filename="../../ui/panels/cell_panel.py" line="397" />
             <source>History of {name}</source>
             <translation>{name} 的历史</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="386" />
+            <location filename="../../ui/panels/cell_panel.py" line="406" />
             <source>Cell {name}: {count} controllers, monitor only</source>
             <translation>单元 {name}：{count} 台控制器，仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="389" />
+            <location filename="../../ui/panels/cell_panel.py" line="410" />
             <source>Back to the cell</source>
             <translation>返回单元</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="390" />
+            <location filename="../../ui/panels/cell_panel.py" line="411" />
             <source>Whole window</source>
             <translation>整个窗口</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="391" />
+            <location filename="../../ui/panels/cell_panel.py" line="412" />
             <source>Show the cell in a window of its own (16 tiles at a glance)</source>
             <translation>在单独窗口中显示单元（一眼看到 16 个磁贴）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="392" />
+            <location filename="../../ui/panels/cell_panel.py" line="413" />
             <source>Export CSV…</source>
             <translation>导出 CSV…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="393" />
+            <location filename="../../ui/panels/cell_panel.py" line="414" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="393" />
+            <location filename="../../ui/panels/cell_panel.py" line="414" />
             <source>Event</source>
             <translation>事件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="393" />
+            <location filename="../../ui/panels/cell_panel.py" line="414" />
             <source>Detail</source>
             <translation>详情</translation>
         </message>
@@ -741,52 +742,52 @@ The pendant connects to it and commands it; every other robot of the cell stays 
     <context>
         <name>CellTile</name>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="166" />
+            <location filename="../../ui/panels/cell_panel.py" line="176" />
             <source>{name} (in control)</source>
             <translation>{name}（控制中）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="169" />
+            <location filename="../../ui/panels/cell_panel.py" line="179" />
             <source>not answering {seconds} s</source>
             <translation>无应答 {seconds} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="171" />
+            <location filename="../../ui/panels/cell_panel.py" line="181" />
             <source>answering</source>
             <translation>正在应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="175" />
+            <location filename="../../ui/panels/cell_panel.py" line="185" />
             <source>no answer yet, {errors} errors/min</source>
             <translation>尚无应答，{errors} 次错误/分钟</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="178" />
+            <location filename="../../ui/panels/cell_panel.py" line="188" />
             <source>{age} s ago, RTT {rtt} ms, {errors} errors/min</source>
             <translation>{age} 秒前，往返 {rtt} 毫秒，{errors} 次错误/分钟</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="203" />
+            <location filename="../../ui/panels/cell_panel.py" line="219" />
             <source>mode {mode}, program {program}</source>
             <translation>模式 {mode}，程序 {program}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="211" />
+            <location filename="../../ui/panels/cell_panel.py" line="227" />
             <source>alarms: {alarms}</source>
             <translation>报警：{alarms}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="213" />
+            <location filename="../../ui/panels/cell_panel.py" line="229" />
             <source>no alarm</source>
             <translation>无报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="220" />
+            <location filename="../../ui/panels/cell_panel.py" line="237" />
             <source>Take control…</source>
             <translation>接管控制…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="221" />
+            <location filename="../../ui/panels/cell_panel.py" line="238" />
             <source>History</source>
             <translation>历史</translation>
         </message>

@@ -353,6 +353,8 @@ class CellPanel(QWidget):
         """End every poller (each ends within its poll timeout) and the refresh."""
         self.timer.stop()
         for poller in self.pollers:
+            poller.request_stop()  # all at once: the joins below then wait one poll timeout, not 16
+        for poller in self.pollers:
             poller.stop()
 
     # --- the pollers' news (GUI thread) -------------------------------------------------
