@@ -20,6 +20,7 @@ from PySide6.QtCore import QEvent, QObject, Qt, Slot
 from PySide6.QtGui import QAction
 
 from app.errors import TeachPadError
+from app.link.types import ConnectionState, LinkState
 from app.safety.roles import Action
 
 if TYPE_CHECKING:  # the cell's modules (Modbus clients, pollers) load with the first cell, not at start-up
@@ -44,6 +45,7 @@ class CellHost(QObject):
         menus.file_menu.insertAction(menus.connect_action, self.open_action)
         menus.file_menu.insertSeparator(menus.connect_action)
         window.installEventFilter(self)
+        window.link.state.connectionChanged.connect(self._on_connection)
         self.retranslate()
 
     # --- opening -----------------------------------------------------------------------
@@ -78,6 +80,7 @@ class CellHost(QObject):
         tabs = self.window.work_tabs
         tabs.setCurrentIndex(tabs.addTab(panel, self.tr("Cell")))
         panel.start()
+        self._on_connection(self.window.link.state.connection)
         return panel
 
     def close_cell(self) -> None:
@@ -109,6 +112,17 @@ class CellHost(QObject):
             tabs.setCurrentIndex(tabs.addTab(panel, self.tr("Cell")))
 
     # --- monitor many, command one -------------------------------------------------------
+    @Slot(object)
+    def _on_connection(self, connection: ConnectionState) -> None:
+        """The tile "in control" is the one the window's link reaches (by Take control or Connect…)."""
+        panel = self.panel
+        if panel is None:
+            return
+        up = connection.state is not LinkState.DISCONNECTED
+        name = next((n for n, t in panel.tiles.items() if up and t.where == connection.endpoint), None)
+        self.controlled = name
+        panel.set_controlled(name)
+
     @Slot(str)
     def take_control(self, name: str) -> bool:
         """Make ``name`` the pendant's robot (see the module docstring); True when connecting."""
@@ -130,9 +144,7 @@ class CellHost(QObject):
         safety.session.audit.record(
             "link", "take control", args={"controller": name, "where": where, "cell": panel.cell.name}
         )
-        window.connect_with(controller.settings(monitor_only=False))
-        self.controlled = name
-        panel.set_controlled(name)
+        window.connect_with(controller.settings(monitor_only=False))  # the tile follows the link's state
         return True
 
     @Slot(str)

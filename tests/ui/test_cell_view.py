@@ -227,6 +227,11 @@ def test_take_control_connects_the_window_to_that_robot_after_a_confirmation(
     qtbot.waitUntil(lambda: sims[1].connections_count == 1 and sims[2].connections_count > 1, timeout=WAIT_MS)
     assert sims[0].connections_count == 1
     assert not panel.tiles["R2"].controlled and panel.tiles["R3"].controlled
+    with qtbot.waitSignal(
+        window.link.connectionChanged, check_params_cb=is_state(LinkState.DISCONNECTED), timeout=WAIT_MS
+    ):
+        window.link.disconnect()
+    assert not any(tile.controlled for tile in panel.tiles.values())
 
 
 def test_closing_the_window_ends_every_poller(qtbot: Any, window: Any, panel: Any) -> None:
