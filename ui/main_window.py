@@ -72,6 +72,7 @@ from ui.panels.view3d_host import install_view3d
 from ui.settings import AppSettings
 from ui.touch import apply_touch_mode, mark_motion
 from ui.window_actions import WindowActions
+from ui.window_cell import install_cell
 from ui.window_column import ControlColumn
 from ui.window_docks import WindowDocks
 from ui.window_geometry import MIN_SIZE, default_size, restore_window
@@ -195,6 +196,7 @@ class MainWindow(QMainWindow):
         self.safety_menu = install_safety(self._safety_parts())  # roles, envelope, audit (Safety menu)
         self.motion.safety = self.safety_menu.safety
         self.run_controller.audit = self.safety_menu.safety.session.audit  # a run's own pause (issue 19)
+        self.cell = install_cell(self)  # File → Open cell…, the Cell tab (issue 23)
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])

@@ -621,6 +621,178 @@
         </message>
     </context>
     <context>
+        <name>CellHost</name>
+        <message>
+            <location filename="../../ui/window_cell.py" line="53" />
+            <source>Open cell</source>
+            <translation>打开单元</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_cell.py" line="53" />
+            <source>Cell files (*.json);;All files (*)</source>
+            <translation>单元文件 (*.json);;所有文件 (*)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_cell.py" line="64" />
+            <source>Cell file</source>
+            <translation>单元文件</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_cell.py" line="79" />
+            <location filename="../../ui/window_cell.py" line="109" />
+            <location filename="../../ui/window_cell.py" line="167" />
+            <source>Cell</source>
+            <translation>单元</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_cell.py" line="104" />
+            <location filename="../../ui/window_cell.py" line="168" />
+            <source>Cell {name}</source>
+            <translation>单元 {name}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_cell.py" line="125" />
+            <source>Take control of {name} ({where})?
+
+The pendant connects to it and commands it; every other robot of the cell stays monitor-only.</source>
+            <translation>接管 {name}（{where}）的控制？
+
+示教器将连接并控制它；单元中其他机器人保持仅监视。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_cell.py" line="128" />
+            <source>Take control</source>
+            <translation>接管控制</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_cell.py" line="146" />
+            <location filename="../../ui/window_cell.py" line="154" />
+            <source>Export history</source>
+            <translation>导出历史</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_cell.py" line="146" />
+            <source>CSV files (*.csv)</source>
+            <translation>CSV 文件 (*.csv)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_cell.py" line="155" />
+            <source>Cannot write {path}: {error}</source>
+            <translation>无法写入 {path}：{error}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_cell.py" line="162" />
+            <source>Open &amp;cell…</source>
+            <translation>打开单元(&amp;C)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_cell.py" line="163" />
+            <source>Watch every controller of a cell file, monitor only</source>
+            <translation>监视单元文件中的每台控制器（仅监视）</translation>
+        </message>
+    </context>
+    <context>
+        <name>CellPanel</name>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="397" />
+            <source>History of {name}</source>
+            <translation>{name} 的历史</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="406" />
+            <source>Cell {name}: {count} controllers, monitor only</source>
+            <translation>单元 {name}：{count} 台控制器，仅监视</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="410" />
+            <source>Back to the cell</source>
+            <translation>返回单元</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="411" />
+            <source>Whole window</source>
+            <translation>整个窗口</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="412" />
+            <source>Show the cell in a window of its own (16 tiles at a glance)</source>
+            <translation>在单独窗口中显示单元（一眼看到 16 个磁贴）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="413" />
+            <source>Export CSV…</source>
+            <translation>导出 CSV…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="414" />
+            <source>Time</source>
+            <translation>时间</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="414" />
+            <source>Event</source>
+            <translation>事件</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="414" />
+            <source>Detail</source>
+            <translation>详情</translation>
+        </message>
+    </context>
+    <context>
+        <name>CellTile</name>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="176" />
+            <source>{name} (in control)</source>
+            <translation>{name}（控制中）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="179" />
+            <source>not answering {seconds} s</source>
+            <translation>无应答 {seconds} 秒</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="181" />
+            <source>answering</source>
+            <translation>正在应答</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="185" />
+            <source>no answer yet, {errors} errors/min</source>
+            <translation>尚无应答，{errors} 次错误/分钟</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="188" />
+            <source>{age} s ago, RTT {rtt} ms, {errors} errors/min</source>
+            <translation>{age} 秒前，往返 {rtt} 毫秒，{errors} 次错误/分钟</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="219" />
+            <source>mode {mode}, program {program}</source>
+            <translation>模式 {mode}，程序 {program}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="227" />
+            <source>alarms: {alarms}</source>
+            <translation>报警：{alarms}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="229" />
+            <source>no alarm</source>
+            <translation>无报警</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="237" />
+            <source>Take control…</source>
+            <translation>接管控制…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="238" />
+            <source>History</source>
+            <translation>历史</translation>
+        </message>
+    </context>
+    <context>
         <name>ConnectionDialog</name>
         <message>
             <location filename="../../ui/dialogs/connection_dialog.py" line="200" />
@@ -1492,7 +1664,7 @@
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="352" />
+            <location filename="../../ui/main_window.py" line="354" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
@@ -1523,7 +1695,7 @@
             <translation>往返 —</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="398" />
+            <location filename="../../ui/main_window.py" line="400" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
@@ -1548,30 +1720,30 @@
             <translation>此控制器上还有另一个 Modbus 主站：{sign}。它与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。请检查还有谁连接着控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="421" />
+            <location filename="../../ui/main_window.py" line="423" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="376" />
-            <location filename="../../ui/main_window.py" line="400" />
-            <location filename="../../ui/main_window.py" line="409" />
-            <location filename="../../ui/main_window.py" line="422" />
+            <location filename="../../ui/main_window.py" line="378" />
+            <location filename="../../ui/main_window.py" line="402" />
+            <location filename="../../ui/main_window.py" line="411" />
+            <location filename="../../ui/main_window.py" line="424" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="329" />
+            <location filename="../../ui/main_window.py" line="331" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="330" />
+            <location filename="../../ui/main_window.py" line="332" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="331" />
+            <location filename="../../ui/main_window.py" line="333" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1581,37 +1753,37 @@
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="416" />
+            <location filename="../../ui/main_window.py" line="418" />
             <source>plan run</source>
             <translation>计划运行</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="496" />
+            <location filename="../../ui/main_window.py" line="498" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="498" />
+            <location filename="../../ui/main_window.py" line="500" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="511" />
+            <location filename="../../ui/main_window.py" line="513" />
             <source>Safety state (roles, envelope, audit trail), machine-wide: {folder}</source>
             <translation>安全状态（角色、安全范围、审计记录），本机共用：{folder}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="513" />
+            <location filename="../../ui/main_window.py" line="515" />
             <source>Safety state (roles, envelope), this user's: {folder}&lt;br&gt;Audit trail: {audit}</source>
             <translation>安全状态（角色、安全范围），当前用户：{folder}&lt;br&gt;审计记录：{audit}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="532" />
+            <location filename="../../ui/main_window.py" line="534" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="532" />
+            <location filename="../../ui/main_window.py" line="534" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
