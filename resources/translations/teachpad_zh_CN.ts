@@ -623,35 +623,35 @@
     <context>
         <name>CellHost</name>
         <message>
-            <location filename="../../ui/window_cell.py" line="53" />
+            <location filename="../../ui/window_cell.py" line="55" />
             <source>Open cell</source>
             <translation>打开单元</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="53" />
+            <location filename="../../ui/window_cell.py" line="55" />
             <source>Cell files (*.json);;All files (*)</source>
             <translation>单元文件 (*.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="64" />
+            <location filename="../../ui/window_cell.py" line="66" />
             <source>Cell file</source>
             <translation>单元文件</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="79" />
-            <location filename="../../ui/window_cell.py" line="109" />
-            <location filename="../../ui/window_cell.py" line="167" />
+            <location filename="../../ui/window_cell.py" line="81" />
+            <location filename="../../ui/window_cell.py" line="112" />
+            <location filename="../../ui/window_cell.py" line="179" />
             <source>Cell</source>
             <translation>单元</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="104" />
-            <location filename="../../ui/window_cell.py" line="168" />
+            <location filename="../../ui/window_cell.py" line="107" />
+            <location filename="../../ui/window_cell.py" line="180" />
             <source>Cell {name}</source>
             <translation>单元 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="125" />
+            <location filename="../../ui/window_cell.py" line="139" />
             <source>Take control of {name} ({where})?
 
 The pendant connects to it and commands it; every other robot of the cell stays monitor-only.</source>
@@ -660,33 +660,33 @@ The pendant connects to it and commands it; every other robot of the cell stays 
 示教器将连接并控制它；单元中其他机器人保持仅监视。</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="128" />
+            <location filename="../../ui/window_cell.py" line="142" />
             <source>Take control</source>
             <translation>接管控制</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="146" />
-            <location filename="../../ui/window_cell.py" line="154" />
+            <location filename="../../ui/window_cell.py" line="158" />
+            <location filename="../../ui/window_cell.py" line="166" />
             <source>Export history</source>
             <translation>导出历史</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="146" />
+            <location filename="../../ui/window_cell.py" line="158" />
             <source>CSV files (*.csv)</source>
             <translation>CSV 文件 (*.csv)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="155" />
+            <location filename="../../ui/window_cell.py" line="167" />
             <source>Cannot write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="162" />
+            <location filename="../../ui/window_cell.py" line="174" />
             <source>Open &amp;cell…</source>
             <translation>打开单元(&amp;C)…</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="163" />
+            <location filename="../../ui/window_cell.py" line="175" />
             <source>Watch every controller of a cell file, monitor only</source>
             <translation>监视单元文件中的每台控制器（仅监视）</translation>
         </message>
@@ -3934,12 +3934,12 @@ The pendant connects to it and commands it; every other robot of the cell stays 
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="362" />
+            <location filename="../../ui/panels/planner_panel.py" line="363" />
             <source>This cell cannot be edited: {why}</source>
             <translation>无法编辑此单元格：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="470" />
+            <location filename="../../ui/panels/planner_panel.py" line="471" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>
