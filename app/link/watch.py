@@ -81,6 +81,7 @@ class MotionWatch:
         # go to zero on joints already at zero: a controller may still report its program running for
         # a moment; with no pose moved it was "already at zero", whichever the polls caught
         self._zero_at_start = zero_axes is not None and _reads_zero(before_pose, zero_axes)
+        self._start_pose = before_pose
         self.result: CommandResult | None = None
         self.error: TeachPadError | None = None
         self.note: OutcomeHook | None = None  # the audit's hook (app/link/outcome.py)
@@ -134,7 +135,8 @@ class MotionWatch:
         moved = pose is not None and self._last_pose is not None and pose_moved(pose, self._last_pose)
         if pose is not None:
             self._last_pose = pose
-        self._moved = self._moved or moved
+        # moved since the last read, or crept away from where it was when sent (slower than a read's step)
+        self._moved = self._moved or moved or _away(pose, self._start_pose)
         if not self.seen:
             if running or moved:
                 self.seen = True
@@ -297,3 +299,8 @@ def _reads_zero(pose: Pose | None, axes: tuple[int, ...]) -> bool:
         return joints_off_zero(pose, axes) is None
     except LookupError:
         return False
+
+
+def _away(pose: Pose | None, start: Pose | None) -> bool:
+    """``pose`` is not where ``start`` was (False when either is unknown)."""
+    return pose is not None and start is not None and pose_moved(pose, start)

@@ -92,6 +92,13 @@ def test_go_to_zero_already_there_while_the_controller_reports_running_for_a_mom
     assert watch.update(IDLE, joints(0.0), 0.1) is None  # still moving
     result = watch.update(IDLE, joints(0.0), 0.15)
     assert result is not None and result.ok and result.message == "go to zero (J2): done"
+    # crept: each read within a read's step of the last (0.0009° a read), 0.09° from where it was sent;
+    # another joint than the one asked moved: not "already at zero" either way
+    watch = MotionWatch(None, "go to zero (J1)", joints(0.0), 0.0, operation="go to zero", zero_axes=(0,))
+    for step in range(1, 101):
+        assert watch.update(RUNNING, joints(0.0009 * step), 0.01 * step) is None
+    result = watch.update(IDLE, joints(0.09), 1.1)
+    assert result is not None and result.ok and result.message == "go to zero (J1): done"
 
 
 def test_watch_outcome_unknown_and_stopped_reach_its_hook() -> None:
