@@ -317,6 +317,32 @@ def _gc_on_the_gui_thread(request: pytest.FixtureRequest) -> Iterator[None]:
             gc.enable()
 
 
+_SAMPLES = os.path.realpath(os.path.join(os.path.dirname(__file__), os.pardir, "resources", "samples"))
+
+
+@pytest.fixture(autouse=True)
+def _sample_project_locks_per_test(
+    monkeypatch: pytest.MonkeyPatch, tmp_path_factory: pytest.TempPathFactory
+) -> None:
+    """A test that opens a shipped sample project (``resources/samples``) takes its lock in a folder
+    of its own, not beside the sample: the suite runs in several processes (``make test -n``), and
+    two of them opening ``demo.teachpad.json`` at once are two TeachPads on one project -- the
+    second is refused, as it must be (``app/points/lock.py``), and its test failed (seen with the
+    suite beside two busy loops). A test of the lock itself uses a project of its own."""
+    import app.points.lock as lock
+
+    folder = tmp_path_factory.mktemp("sample-locks")
+    original = lock.lock_path
+
+    def lock_path(project_path: str | os.PathLike[str]) -> Any:
+        path = original(project_path)
+        if os.path.dirname(os.path.realpath(project_path)) == _SAMPLES:
+            return folder / path.name
+        return path
+
+    monkeypatch.setattr(lock, "lock_path", lock_path)
+
+
 @pytest.fixture(autouse=True)
 def _private_safety_state(monkeypatch: pytest.MonkeyPatch, tmp_path_factory: pytest.TempPathFactory) -> None:
     """Each test its own per-user folders (``app.safety.location``): the role store, the envelope,

@@ -59,7 +59,9 @@ def test_a_small_restore_against_the_simulator_has_every_key() -> None:
     assert out["points"] == 30 and out["rounds"] == 3 and out["points_per_round"] == 10
     assert out["failed"] == 0 and out["held_by_controller"] == 30
     assert len(out["round_ratios"]) == 3 and len(out["round_s"]) == 3
-    assert out["ratio_vs_bound"] == round(statistics.median(out["round_ratios"]), 2)
+    # the median of the unrounded ratios, rounded to 2 places; the listed ratios are rounded to 3, so
+    # their median may round the other way at a half (1.925 -> 1.93 against 1.9249.. -> 1.92)
+    assert abs(out["ratio_vs_bound"] - statistics.median(out["round_ratios"])) <= 0.0051
     assert len(out["bare_cycles_per_sample"]) == 4 and min(out["bare_cycles_per_sample"]) > 0
     for key in ("restore_s", "min_transactions_bound_s", "rtt_ms", "points_per_s", "ratio_total"):
         assert out[key] > 0
