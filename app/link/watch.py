@@ -132,7 +132,7 @@ class MotionWatch:
         if status.alarms:
             return self._alarm(int(status.alarms), now)
         running = status.program_state in (ProgramState.RUNNING, ProgramState.PAUSED)
-        moved = pose is not None and self._last_pose is not None and pose_moved(pose, self._last_pose)
+        moved = _away(pose, self._last_pose)
         if pose is not None:
             self._last_pose = pose
         # moved since the last read, or crept away from where it was when sent (slower than a read's step)
@@ -159,7 +159,7 @@ class MotionWatch:
 
     def _not_started(self, now: float) -> CommandResult:
         seconds = round(self.ack_timeout, 3)
-        if self.zero_axes is not None and self._at_zero() is True:
+        if self.zero_axes is not None and _reads_zero(self._last_pose, self.zero_axes):
             return self._already_at_zero(now)
         if self.program is not None:
             text = (
@@ -192,14 +192,6 @@ class MotionWatch:
         return self._end(
             True, f"{self.text}: done (already at zero)", now, Reason("zero_already", self._args())
         )
-
-    def _at_zero(self) -> bool | None:
-        """The joints asked for read zero now (None: the controller does not report them)."""
-        assert self.zero_axes is not None
-        try:
-            return joints_off_zero(self._last_pose, self.zero_axes) is None
-        except LookupError:
-            return None
 
     def stopped(self, now: float) -> CommandResult:
         """The host sent stop itself."""
