@@ -10,10 +10,12 @@ import sys
 from pathlib import Path
 from typing import Any
 
+import pytest
+
 from benchmarks.goals import GOALS
 
 ROOT = Path(__file__).resolve().parents[2]
-RUN_TIMEOUT = 180.0  # s: the quick suite takes seconds; a loaded 2-core machine more
+RUN_TIMEOUT = 360.0  # s: the quick suite takes ~20 s; beside eight engineers' work it took over 120
 
 GATEWAY_KEYS = (
     "gateway.gateway_64.cpu_pct_of_one_core",
@@ -31,6 +33,7 @@ def _lookup(data: dict[str, Any], key: str) -> Any:
     return node
 
 
+@pytest.mark.timeout(RUN_TIMEOUT + 60)  # its own limit, not the suite's 120 s
 def test_the_gateway_suite_quick_run_prints_its_keys_beside_their_goals() -> None:
     env = dict(os.environ, PYTHONPATH=str(ROOT), QT_QPA_PLATFORM="offscreen")
     done = subprocess.run(
