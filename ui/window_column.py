@@ -141,9 +141,11 @@ class ControlColumn(QWidget):
 
     @Slot()
     def _make_room(self) -> None:
-        """A line shown in the column under or over the tabs: the jog panel gives it its hints'
-        height (the six rows keep fitting a 1280×800 screen)."""
-        self.jog_panel.make_room(self.refusal_line.shown or self._word_order is not None)
+        """A line shown in the column under or over the tabs (the refusal, the motion banner,
+        another master, the word order): the jog panel gives it its hints' height (the six rows
+        keep fitting a 1280×800 screen)."""
+        banners = (self.motion_banner, self.foreign_banner, self.word_order_banner)
+        self.jog_panel.make_room(self.refusal_line.shown or any(not b.isHidden() for b in banners))
 
     @Slot(ConnectionState)
     def _on_connection(self, connection: ConnectionState) -> None:
@@ -162,6 +164,7 @@ class ControlColumn(QWidget):
         self.foreign_banner.setText(foreign_master_text(what, value))
         self.foreign_banner.setVisible(True)
         self._foreign_timer.start(FOREIGN_BANNER_MS)
+        self._make_room()
         return new
 
     @Slot()
@@ -169,6 +172,7 @@ class ControlColumn(QWidget):
         self._foreign_timer.stop()
         self._foreign_sign = None
         self.foreign_banner.setVisible(False)
+        self._make_room()
 
     def _show_banner(self) -> None:
         state = self._state
@@ -183,6 +187,7 @@ class ControlColumn(QWidget):
                 QCoreApplication.translate("MainWindow", "Not connected: motion controls are disabled")
             )
         self.motion_banner.setVisible(not writable)
+        self._make_room()
 
 
 def _build_step_panel() -> StepPanel:

@@ -422,6 +422,26 @@ def test_joint_jog_fits_1280x800_without_scrolling(
 
 
 @pytest.mark.parametrize("language", LANGUAGES)
+def test_the_jog_rows_fit_1280x800_under_the_motion_banner(
+    language: str, make_window: Callable[..., MainWindow], qtbot: Any, sim: Any
+) -> None:
+    """The "Not connected" banner takes the hints' height, not a jog row's: the six rows show
+    whole, no scroll bar; connected, the hints come back."""
+    window = make_window(language, LAPTOP, connected=False)
+    jog = window.jog_panel
+    settle()
+    assert window.motion_banner.isVisible()
+    assert not jog.axes_scroll.verticalScrollBar().isVisible()
+    for axis in range(6):
+        for direction in (0, 1):
+            button = jog.button(axis, direction)
+            assert button.isVisible() and not button.visibleRegion().isEmpty(), (axis, direction)
+    connect_window(qtbot, window, sim)
+    assert window.motion_banner.isHidden() and jog.keys_label.isVisible()  # the room given back
+    assert not jog.axes_scroll.verticalScrollBar().isVisible()
+
+
+@pytest.mark.parametrize("language", LANGUAGES)
 def test_dialogs_layout(qtbot: Any, app_settings: Any, translator: Any, language: str) -> None:
     assert translator.set_language(language)
     parent = QWidget()
