@@ -21,6 +21,7 @@ from urllib.parse import urlsplit
 
 from app import timing
 from app.cell.cell_file import CellFileError, load_cell
+from app.gateway.bdseq import default_bdseq_file
 from app.gateway.edge_node import BrokerSettings, EdgeNode
 from app.gateway.poller import GatewayTiming
 from app.version import VersionAction
@@ -71,6 +72,14 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--poll-hz", type=float, default=timing.GATEWAY_POLL_HZ, help="polls per controller per s"
+    )
+    parser.add_argument(
+        "--bdseq-file",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="where the Sparkplug bdSeq is kept across restarts "
+        "(default: TeachPad's data folder, gateway/GROUP.NODE.bdseq.json)",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log every connection change")
     return parser
@@ -145,7 +154,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         print(f"{PROG}: {exc}", file=sys.stderr)
         return EXIT_USAGE
     gateway = GatewayTiming(poll_hz=args.poll_hz, keepalive=args.keepalive)
-    edge = EdgeNode(cell, broker, group=group, node=node, gateway=gateway, primary_host=primary)
+    bdseq_file = args.bdseq_file or default_bdseq_file(group, node)
+    edge = EdgeNode(
+        cell, broker, group=group, node=node, gateway=gateway, primary_host=primary, bdseq_file=bdseq_file
+    )
     done = threading.Event()
     reload = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):

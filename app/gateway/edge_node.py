@@ -6,6 +6,8 @@ What the specification asks of an edge node, and how it is met here:
 * **NDEATH is the MQTT will** (QoS 1, not retained) carrying ``bdSeq``; a new MQTT session (a
   reconnect after the broker went away) sets the will again with ``bdSeq + 1`` (0..255) before it
   connects. A graceful stop publishes NDEATH itself (a clean disconnect does not fire the will).
+  With ``bdseq_file`` (the CLI's default: :func:`app.gateway.bdseq.default_bdseq_file`) the bdSeq
+  in use is kept on disk before each CONNECT, and a restarted gateway goes on from it + 1.
 * On every connect: subscribe to NCMD, then **NBIRTH** (``seq`` 0, the same ``bdSeq``, the
   ``Node Control/Rebirth`` metric), then a **DBIRTH** per answering controller (every metric, name and
   alias), then **DDATA** by exception: only the metrics that moved past their deadband, by alias only.
@@ -31,6 +33,7 @@ from __future__ import annotations
 
 import json
 import logging
+import os
 import ssl
 import threading
 import time
@@ -46,6 +49,7 @@ from paho.mqtt.enums import CallbackAPIVersion
 from app import timing
 from app.cell.cell_file import Cell
 from app.gateway import payload as pb
+from app.gateway.bdseq import BdSeqStore
 from app.gateway.metrics import (
     BDSEQ,
     DEVICE_METRICS,
@@ -111,6 +115,7 @@ class EdgeNode:
         deadbands: Mapping[str, float] | None = None,
         history_limit: int | None = None,
         primary_host: str | None = None,
+        bdseq_file: str | os.PathLike[str] | None = None,
     ) -> None:
         self.group = group
         self.node = node
@@ -122,7 +127,9 @@ class EdgeNode:
         self._controllers = {c.name: c for c in cell.controllers}
         self._pollers = {c.name: ControllerPoller(c, self, self.timing) for c in cell.controllers}
         self._next_index = len(cell.controllers)  # a controller that joins later: aliases never reused
-        self.bdseq = 0
+        # the last session's bdSeq + 1 when kept in a file (a restart is a new session too), else 0
+        self._bdseq_store = None if bdseq_file is None else BdSeqStore(bdseq_file, group, node)
+        self.bdseq = 0 if self._bdseq_store is None else self._bdseq_store.first()
         self._seq = 0
         self._online = False  # an MQTT session is up and NBIRTH went out
         self.sessions = 0  # MQTT sessions so far (NBIRTHs after a connect)
@@ -169,6 +176,9 @@ class EdgeNode:
         return client
 
     def _set_will(self, client: mqtt.Client) -> None:
+        """The session's will (its bdSeq: kept in the file first, when there is one)."""
+        if self._bdseq_store is not None:
+            self._bdseq_store.save(self.bdseq)
         client.will_set(self.topic("NDEATH"), self._ndeath(), qos=1, retain=False)
 
     def _ndeath(self) -> bytes:

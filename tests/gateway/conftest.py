@@ -261,6 +261,7 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
         history_limit: int | None = None,
         port: int | None = None,
         primary_host: str | None = None,
+        bdseq_file: Path | None = None,
         **clocks: Any,
     ) -> EdgeNode:
         cell = load_cell(write_cell(tmp_path, sims))
@@ -273,6 +274,7 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
             deadbands=deadbands,
             history_limit=history_limit,
             primary_host=primary_host,
+            bdseq_file=bdseq_file,
         )
         node.start()
         made.append(node)
