@@ -239,9 +239,8 @@ class PlantWriter:
             raise PlantRefused(
                 f"speed ratio {ratio} % is above the {self._cap():g} % the safety envelope allows"
             )
-        with client.judged_writes() as judged:
-            watch = client.run_program(program, ProgramMotionMode.SINGLE_RUN, 1, ratio, before=pose)
-        watch.note = outcome_note(client.audit, judged)
+        # as the pendant's and the CLI's: the trigger (440) is judged, its outcome recorded against it
+        watch = client.run_program(program, ProgramMotionMode.SINGLE_RUN, 1, ratio, before=pose)
         self._following = (command, watch)
         self._say(
             command, f"sent: run program {program} at {ratio} % (under way)", {"Plant/Program run": program}

@@ -232,12 +232,21 @@ def subscriber(broker: Broker) -> Iterator[Subscriber]:
         sub.close()
 
 
-def write_cell(folder: Path, sims: dict[str, Any], name: str = "test cell") -> Path:
-    """A cell file with one controller per simulator (its name -> the simulator), written by the product."""
+def write_cell(
+    folder: Path,
+    sims: dict[str, Any],
+    name: str = "test cell",
+    options: dict[str, dict[str, Any]] | None = None,
+) -> Path:
+    """A cell file with one controller per simulator (its name -> the simulator), written by the
+    product; ``options``: more fields of a controller by its name (``plant_writes``, ``external_axes``)."""
     from app.cell.cell_file import Cell, CellController, save_cell
 
     path = folder / "cell.json"
-    controllers = tuple(CellController(n, host="127.0.0.1", port=sim.port) for n, sim in sims.items())
+    more = options or {}
+    controllers = tuple(
+        CellController(n, host="127.0.0.1", port=sim.port, **more.get(n, {})) for n, sim in sims.items()
+    )
     save_cell(path, Cell(name, controllers))
     return path
 
@@ -262,9 +271,11 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
         port: int | None = None,
         primary_host: str | None = None,
         bdseq_file: Path | None = None,
+        options: dict[str, dict[str, Any]] | None = None,
+        envelope: Any = None,
         **clocks: Any,
     ) -> EdgeNode:
-        cell = load_cell(write_cell(tmp_path, sims))
+        cell = load_cell(write_cell(tmp_path, sims, options=options))
         node = EdgeNode(
             cell,
             BrokerSettings("127.0.0.1", port or broker.port),
@@ -275,6 +286,8 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
             history_limit=history_limit,
             primary_host=primary_host,
             bdseq_file=bdseq_file,
+            envelope=envelope,
+            audit_dir=tmp_path / "audit",
         )
         node.start()
         made.append(node)
