@@ -182,8 +182,12 @@ class EdgeNode:
         self.history_dropped = 0  # DDATA the bound dropped while the broker was away, since the start
         self._client = self._make_client()
 
+    def _allowed(self, controller: CellController) -> CellController:
+        """``controller`` as this node serves it: without plant writes when ``writes`` is off."""
+        return controller if self._writes else dataclasses.replace(controller, plant_writes=())
+
     def _device(self, controller: CellController, index: int) -> _Device:
-        return _Device(controller.name, index, device_metrics(controller))
+        return _Device(controller.name, index, device_metrics(self._allowed(controller)))
 
     def _poller(self, controller: CellController) -> ControllerPoller:
         """Its poller, and its plant writer (which refuses what is not enabled; the poller only
@@ -193,8 +197,7 @@ class EdgeNode:
 
     def _writer(self, controller: CellController) -> PlantWriter:
         name = controller.name
-        if not self._writes:
-            controller = dataclasses.replace(controller, plant_writes=())
+        controller = self._allowed(controller)
         if controller.plant_writes and self._envelope is None:
             from app.cli.guard import envelope_in_force  # read once, when a robot has plant writes
 
