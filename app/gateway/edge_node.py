@@ -159,6 +159,7 @@ class EdgeNode:
         self._writes = writes
         self._pendant_robot: str | None = None
         self._writers: dict[str, PlantWriter] = {}
+        self._read_envelope(cell.controllers)
         self._devices = {c.name: self._device(c, i) for i, c in enumerate(cell.controllers)}
         self._controllers = {c.name: c for c in cell.controllers}
         self._pollers = {c.name: self._poller(c) for c in cell.controllers}
@@ -182,6 +183,14 @@ class EdgeNode:
         self.history_dropped = 0  # DDATA the bound dropped while the broker was away, since the start
         self._client = self._make_client()
 
+    def _read_envelope(self, controllers: tuple[CellController, ...]) -> None:
+        """The safety envelope in force (the GUI's and the CLI's), read once when a robot has plant
+        writes (before anything changes: one that cannot be read raises, nothing is half made)."""
+        if self._envelope is None and self._writes and any(c.plant_writes for c in controllers):
+            from app.cli.guard import envelope_in_force
+
+            self._envelope = envelope_in_force()
+
     def _allowed(self, controller: CellController) -> CellController:
         """``controller`` as this node serves it: without plant writes when ``writes`` is off."""
         return controller if self._writes else dataclasses.replace(controller, plant_writes=())
@@ -198,10 +207,6 @@ class EdgeNode:
     def _writer(self, controller: CellController) -> PlantWriter:
         name = controller.name
         controller = self._allowed(controller)
-        if controller.plant_writes and self._envelope is None:
-            from app.cli.guard import envelope_in_force  # read once, when a robot has plant writes
-
-            self._envelope = envelope_in_force()
         audit = AuditLog(self._audit_dir, role=plant_audit_role(name))
         return PlantWriter(controller, self._envelope, audit, self, lambda: self._pendant_robot == name)
 
@@ -282,6 +287,7 @@ class EdgeNode:
         """The cell file changed: a controller that left (or whose settings changed) gets its DDEATH
         and its poller stops; one that joined gets a poller (and its DBIRTH at its first answer, with
         aliases of its own: a device index is never used twice)."""
+        self._read_envelope(cell.controllers)
         wanted = {c.name: c for c in cell.controllers}
         with self._lock:
             leaving = [n for n, c in self._controllers.items() if wanted.get(n) != c]
