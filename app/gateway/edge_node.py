@@ -1,6 +1,7 @@
 """The Sparkplug B 3.0 edge node: the TeachPad host is the node, each controller of the cell a device.
 
-Topics: ``spBv1.0/GROUP/{NBIRTH,NDEATH,NCMD}/NODE`` and ``spBv1.0/GROUP/{DBIRTH,DDATA,DDEATH}/NODE/DEVICE``.
+Topics: ``spBv1.0/GROUP/{NBIRTH,NDEATH,NCMD}/NODE`` and
+``spBv1.0/GROUP/{DBIRTH,DDATA,DDEATH,DCMD}/NODE/DEVICE``.
 What the specification asks of an edge node, and how it is met here:
 
 * **NDEATH is the MQTT will** (QoS 1, not retained) carrying ``bdSeq``; a new MQTT session (a
@@ -29,8 +30,9 @@ What the specification asks of an edge node, and how it is met here:
   robot (:mod:`app.gateway.plant`). What became of it is the device's ``Plant/Last command result``
   (a DDATA). The DBIRTH advertises the writable metrics a robot has.
 
-Threads: paho's network thread (connect, NCMD) and one poller thread per controller call in here;
-one lock orders everything the node publishes, so ``seq`` goes out in order.
+Threads: paho's network thread (connect, NCMD, DCMD) and one poller thread per controller call in
+here; one lock orders everything the node publishes, so ``seq`` goes out in order. A DCMD's writes
+are made in its robot's poller thread (its client's only thread), never in paho's.
 """
 
 from __future__ import annotations
