@@ -261,6 +261,7 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
     from app.cell.cell_file import load_cell
     from app.gateway.edge_node import BrokerSettings, EdgeNode
     from app.gateway.poller import GatewayTiming
+    from app.safety.envelope import Envelope
 
     made: list[EdgeNode] = []
 
@@ -286,7 +287,8 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
             history_limit=history_limit,
             primary_host=primary_host,
             bdseq_file=bdseq_file,
-            envelope=envelope,
+            # the test's own envelope (the one in force is the session's: another test may save one)
+            envelope=envelope if envelope is not None else Envelope(),
             audit_dir=tmp_path / "audit",
         )
         node.start()
