@@ -118,3 +118,7 @@ GATEWAY_CLOCK_PERIOD = 1.0  # s between reads of the controller's clock (with th
 GATEWAY_STOP_WAIT = 2.0  # s a stopping gateway waits for its NDEATH to be sent
 # DDATA kept while the broker is away (sent flagged is_historical when it is back); older ones are dropped
 GATEWAY_HISTORY_LIMIT = 10_000
+# A plant write (DCMD) is refused while another master was seen on that controller this recently (s):
+# a pendant stepping or moving to points between its commands still commands the robot
+GATEWAY_PLANT_PENDANT_WINDOW = 10.0
+GATEWAY_PLANT_COMMAND_TTL = 2.0  # s a DCMD may wait for its robot's poller; older: refused, never late

@@ -6,7 +6,8 @@
      "controllers": [
        {"name": "R1", "host": "10.0.3.11", "port": 502, "unit": 1,
         "register_profile": "r1.registers.json", "robot_profile": "bc6.json"},
-       {"name": "R2", "rtu": "/dev/ttyUSB0", "baud": 115200, "unit": 2}
+       {"name": "R2", "rtu": "/dev/ttyUSB0", "baud": 115200, "unit": 2,
+        "external_axes": 2, "plant_writes": ["program/run", "program/stop", "speed_ratio"]}
      ]}
 
 Each controller is reached over Modbus TCP (``host``, ``port``: default 502) or RTU on a serial
@@ -15,7 +16,10 @@ profile's, else 1). ``register_profile`` (a ``.registers.json`` as the GUI saves
 :mod:`app.safety.register_profile`) says how its registers read; ``robot_profile`` (a
 ``teachpad-robot-profile``: :mod:`app.view3d.profile`) its arm. Profile paths are relative to the
 cell file's folder. Both are read when the cell is loaded, so a bad one is found before anything
-connects.
+connects. ``external_axes`` (0..5, default 0): how many of the external axes E1..E5 the robot has
+(the gateway publishes those). ``plant_writes`` (default none): the writes a plant may make to this
+robot through ``teachpad-gateway``'s DCMD, each named (:data:`app.safety.roles.PLANT_WRITES`), each
+an administrator's decision; a list without them (or no list) is a robot the plant only watches.
 
 A problem is one line naming the file, the controller and the field (``cell.json: controller
 'R2': port must be a whole number 1..65535, got 70000``): :class:`CellFileError`.
@@ -34,6 +38,7 @@ from app.connection import ConnectionSettings
 from app.errors import ProfileError, TeachPadError
 from app.points.atomic import atomic_write_bytes, read_settings_text, versioned_document
 from app.safety.register_profile import RegisterProfile, RegisterProfileError, load_register_profile
+from app.safety.roles import PLANT_WRITES
 from app.view3d.profile import RobotProfile, load_profile
 
 __all__ = ["FORMAT", "VERSION", "Cell", "CellController", "CellFileError", "load_cell", "save_cell"]
@@ -48,7 +53,21 @@ DEFAULT_BAUD = 115200
 BAUD_RANGE = (1200, 4_000_000)
 UNIT_RANGE = (0, 247)
 _TOP_FIELDS = frozenset({"format", "version", "name", "controllers"})
-_FIELDS = frozenset({"name", "host", "port", "rtu", "baud", "unit", "register_profile", "robot_profile"})
+_FIELDS = frozenset(
+    {
+        "name",
+        "host",
+        "port",
+        "rtu",
+        "baud",
+        "unit",
+        "register_profile",
+        "robot_profile",
+        "external_axes",
+        "plant_writes",
+    }
+)
+MAX_EXTERNAL_AXES = 5
 
 
 class CellFileError(TeachPadError):
@@ -69,6 +88,8 @@ class CellController:
     robot_profile: str | None = None
     registers: RegisterProfile | None = None  # the register profile read (None: none named)
     robot: RobotProfile | None = None
+    external_axes: int = 0  # E1..E<n> are present
+    plant_writes: tuple[str, ...] = ()  # what the plant may write (app.safety.roles.PLANT_WRITES)
 
     def settings(self, *, monitor_only: bool = True) -> ConnectionSettings:
         """How TeachPad reaches it: the register profile's decisions, then the cell's unit."""
@@ -93,6 +114,10 @@ class CellController:
         optional = {"unit": self.unit, "register_profile": self.register_profile}
         optional["robot_profile"] = self.robot_profile
         out.update({key: value for key, value in optional.items() if value is not None})
+        if self.external_axes:
+            out["external_axes"] = self.external_axes
+        if self.plant_writes:
+            out["plant_writes"] = list(self.plant_writes)
         return out
 
 
@@ -160,6 +185,22 @@ def _profiles(raw: dict[str, Any], base: Path) -> dict[str, Any]:
     return {"register_profile": registers, "robot_profile": robot, **out}
 
 
+def _plant_writes(raw: dict[str, Any]) -> tuple[str, ...]:
+    value = raw.get("plant_writes", [])
+    if not isinstance(value, list):
+        raise ValueError(
+            f"plant_writes must be a list of names ({', '.join(PLANT_WRITES)}), got {_quote(value)}"
+        )
+    for item in value:
+        if item not in PLANT_WRITES:
+            raise ValueError(
+                f"plant_writes: {_quote(item)} is not a write the plant may make ({', '.join(PLANT_WRITES)})"
+            )
+    if len(set(value)) != len(value):
+        raise ValueError("plant_writes names a write twice")
+    return tuple(value)
+
+
 def _controller(raw: object, index: int, base: Path) -> CellController:
     label = f"controller {index + 1}"
     try:
@@ -176,7 +217,12 @@ def _controller(raw: object, index: int, base: Path) -> CellController:
         if unknown:
             raise ValueError(f"unknown field {_quote(unknown[0])}")
         return CellController(
-            name=name, unit=_whole(raw, "unit", None, UNIT_RANGE), **_where(raw), **_profiles(raw, base)
+            name=name,
+            unit=_whole(raw, "unit", None, UNIT_RANGE),
+            external_axes=_whole(raw, "external_axes", 0, (0, MAX_EXTERNAL_AXES)) or 0,
+            plant_writes=_plant_writes(raw),
+            **_where(raw),
+            **_profiles(raw, base),
         )
     except ValueError as exc:
         raise CellFileError(f"{label}: {exc}") from None

@@ -25,7 +25,7 @@ from app.models import ControllerStatus
 from app.points.atomic import atomic_write_bytes
 from app.protocol.enums import ALARM_BITS, ALARM_TEXT, Alarm, ProgramState
 
-__all__ = ["HISTORY_BOUND", "CellEvent", "ControllerHistory", "alarm_order"]
+__all__ = ["HISTORY_BOUND", "CellEvent", "ControllerHistory", "alarm_order", "program_cycle"]
 
 HISTORY_BOUND = 1000
 CSV_HEADER = ("time", "controller", "kind", "detail")
@@ -68,6 +68,22 @@ def alarm_order(alarms: int, raised_at: dict[int, int]) -> list[Alarm]:
     then the oldest first among equals (``raised_at``: bit -> ms it was first seen)."""
     bits = [bit for bit in ALARM_BITS if alarms & bit]
     return sorted(bits, key=lambda bit: (ALARM_BITS.index(bit), raised_at.get(int(bit), 0)))
+
+
+def program_cycle(before: int, now: int, alarms: int) -> str | None:
+    """What a change of the program-state register (561) from ``before`` to ``now`` is of a program
+    cycle: ``"started"``, ``"finished"``, ``"stopped"`` (the module's rule), or None (none of them).
+    The gateway's cycle counters count the same (:mod:`app.gateway.metrics`)."""
+    stopped, running = int(ProgramState.STOPPED), int(ProgramState.RUNNING)
+    if before == now:
+        return None
+    if before == stopped and now == running:
+        return "started"
+    if now == stopped and before == running and not alarms:
+        return "finished"
+    if now == stopped:
+        return "stopped"
+    return None
 
 
 class ControllerHistory:
@@ -122,15 +138,12 @@ class ControllerHistory:
     def _program(self, before: int, now: int, alarms: int, wall_ms: int) -> None:
         if before == now:
             return
-        stopped, running = int(ProgramState.STOPPED), int(ProgramState.RUNNING)
-        if before == stopped and now == running:
-            self._add(wall_ms, "program started", "")
-        elif now == stopped and before == running and not alarms:
-            self._add(wall_ms, "program finished", "")
-        elif now == stopped:
-            self._add(
-                wall_ms, "program stopped", "alarm" if alarms else f"from {_name(before, ProgramState)}"
+        cycle = program_cycle(before, now, alarms)
+        if cycle is not None:
+            detail = (
+                "" if cycle != "stopped" else "alarm" if alarms else f"from {_name(before, ProgramState)}"
             )
+            self._add(wall_ms, f"program {cycle}", detail)
         else:
             detail = f"program {_name(before, ProgramState)} -> {_name(now, ProgramState)}"
             self._add(wall_ms, "state", detail)

@@ -1,9 +1,12 @@
 """``teachpad-gateway CELL_FILE --broker mqtt://HOST:PORT [--group G] [--node N]``: headless, no widgets.
 
-Polls every controller of the cell (read-only) and publishes it as a Sparkplug B edge node
-(:mod:`app.gateway.edge_node`) until SIGINT or SIGTERM, then publishes NDEATH and exits 0. SIGHUP
-reads the cell file again (a controller that left gets its DDEATH, one that joined its DBIRTH). Exit 2
-(nothing started) for bad arguments or a cell file that cannot be used, with one line saying why.
+Polls every controller of the cell and publishes it as a Sparkplug B edge node
+(:mod:`app.gateway.edge_node`) until SIGINT or SIGTERM, then publishes NDEATH and exits 0. Writes
+from the plant (DCMD) only where the cell file enables them (``plant_writes``,
+:mod:`app.gateway.plant`), none with ``--monitor-only``. SIGHUP reads the cell file again (a
+controller that left gets its DDEATH, one that joined its DBIRTH). Exit 2 (nothing started) for bad
+arguments, a cell file that cannot be used, or a safety envelope that cannot be read when plant
+writes need it, with one line saying why.
 """
 
 from __future__ import annotations
@@ -20,7 +23,9 @@ from pathlib import Path
 from urllib.parse import urlsplit
 
 from app import timing
-from app.cell.cell_file import CellFileError, load_cell
+from app.cell.cell_file import Cell, load_cell
+from app.errors import TeachPadError
+from app.gateway.bdseq import default_bdseq_file
 from app.gateway.edge_node import BrokerSettings, EdgeNode
 from app.gateway.poller import GatewayTiming
 from app.version import VersionAction
@@ -40,7 +45,8 @@ def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(
         prog=PROG,
         description="Publish every controller of a TeachPad cell file to an MQTT broker as a Sparkplug B "
-        "edge node (read-only: nothing is written to a controller).",
+        "edge node. Writes from the plant (DCMD) are off unless the cell file enables them per robot "
+        "(plant_writes).",
     )
     parser.add_argument("--version", action=VersionAction)
     parser.add_argument("cell", type=Path, metavar="CELL_FILE", help="the cell file (teachpad-cell JSON)")
@@ -71,6 +77,19 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument(
         "--poll-hz", type=float, default=timing.GATEWAY_POLL_HZ, help="polls per controller per s"
+    )
+    parser.add_argument(
+        "--bdseq-file",
+        type=Path,
+        default=None,
+        metavar="FILE",
+        help="where the Sparkplug bdSeq is kept across restarts "
+        "(default: TeachPad's data folder, gateway/GROUP.NODE.bdseq.json)",
+    )
+    parser.add_argument(
+        "--monitor-only",
+        action="store_true",
+        help="write nothing to any controller, whatever the cell file's plant_writes enable",
     )
     parser.add_argument("-v", "--verbose", action="store_true", help="log every connection change")
     return parser
@@ -120,10 +139,25 @@ def _reload(edge: EdgeNode, path: Path) -> None:
     """SIGHUP: the cell file again; a file that cannot be used is said and the running cell kept."""
     try:
         cell = load_cell(path)
-    except CellFileError as exc:
+        edge.set_cell(cell)
+    except TeachPadError as exc:  # the cell file, or the envelope its plant writes need
         print(f"{PROG}: cell file not reloaded, the running cell stays: {exc}", file=sys.stderr, flush=True)
-        return
-    edge.set_cell(cell)
+
+
+def _edge_node(
+    args: argparse.Namespace, cell: Cell, broker: BrokerSettings, group: str, node: str, primary: str | None
+) -> EdgeNode:
+    """The edge node (the safety envelope read when a robot has plant writes: a bad one raises)."""
+    return EdgeNode(
+        cell,
+        broker,
+        group=group,
+        node=node,
+        gateway=GatewayTiming(poll_hz=args.poll_hz, keepalive=args.keepalive),
+        primary_host=primary,
+        bdseq_file=args.bdseq_file or default_bdseq_file(group, node),
+        writes=not args.monitor_only,
+    )
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -141,11 +175,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         node = _name(args.node if args.node is not None else socket.gethostname(), "--node")
         primary = None if args.primary_host is None else _name(args.primary_host, "--primary-host")
         cell = load_cell(args.cell)
-    except (UsageError, CellFileError) as exc:
+        edge = _edge_node(args, cell, broker, group, node, primary)
+    except (UsageError, TeachPadError) as exc:  # TeachPadError: the cell file, or the envelope
         print(f"{PROG}: {exc}", file=sys.stderr)
         return EXIT_USAGE
-    gateway = GatewayTiming(poll_hz=args.poll_hz, keepalive=args.keepalive)
-    edge = EdgeNode(cell, broker, group=group, node=node, gateway=gateway, primary_host=primary)
     done = threading.Event()
     reload = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):

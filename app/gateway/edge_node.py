@@ -1,11 +1,14 @@
 """The Sparkplug B 3.0 edge node: the TeachPad host is the node, each controller of the cell a device.
 
-Topics: ``spBv1.0/GROUP/{NBIRTH,NDEATH,NCMD}/NODE`` and ``spBv1.0/GROUP/{DBIRTH,DDATA,DDEATH}/NODE/DEVICE``.
+Topics: ``spBv1.0/GROUP/{NBIRTH,NDEATH,NCMD}/NODE`` and
+``spBv1.0/GROUP/{DBIRTH,DDATA,DDEATH,DCMD}/NODE/DEVICE``.
 What the specification asks of an edge node, and how it is met here:
 
 * **NDEATH is the MQTT will** (QoS 1, not retained) carrying ``bdSeq``; a new MQTT session (a
   reconnect after the broker went away) sets the will again with ``bdSeq + 1`` (0..255) before it
   connects. A graceful stop publishes NDEATH itself (a clean disconnect does not fire the will).
+  With ``bdseq_file`` (the CLI's default: :func:`app.gateway.bdseq.default_bdseq_file`) the bdSeq
+  in use is kept on disk before each CONNECT, and a restarted gateway goes on from it + 1.
 * On every connect: subscribe to NCMD, then **NBIRTH** (``seq`` 0, the same ``bdSeq``, the
   ``Node Control/Rebirth`` metric), then a **DBIRTH** per answering controller (every metric, name and
   alias), then **DDATA** by exception: only the metrics that moved past their deadband, by alias only.
@@ -21,22 +24,30 @@ What the specification asks of an edge node, and how it is met here:
   while it says online; an offline STATE (not older than the last one) ends the session: NDEATH,
   disconnect, a new session (``bdSeq`` + 1) that waits for online again. Changes meanwhile are kept
   as while the broker is away.
-* Nothing from the plant is written to a controller: DCMD is not subscribed to (writes are off).
+* **DCMD** (``spBv1.0/GROUP/DCMD/NODE/+``, by name or alias): writes from the plant, off unless the
+  cell file enables them per robot (``plant_writes``); each goes through the plant role, the one
+  write guard, the safety envelope and the audit trail, and is refused while a pendant commands the
+  robot (:mod:`app.gateway.plant`). What became of it is the device's ``Plant/Last command result``
+  (a DDATA). The DBIRTH advertises the writable metrics a robot has.
 
-Threads: paho's network thread (connect, NCMD) and one poller thread per controller call in here;
-one lock orders everything the node publishes, so ``seq`` goes out in order.
+Threads: paho's network thread (connect, NCMD, DCMD) and one poller thread per controller call in
+here; one lock orders everything the node publishes, so ``seq`` goes out in order. A DCMD's writes
+are made in its robot's poller thread (its client's only thread), never in paho's.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import logging
+import os
 import ssl
 import threading
 import time
 from collections import deque
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import paho.mqtt.client as mqtt
@@ -44,21 +55,30 @@ from google.protobuf.message import DecodeError
 from paho.mqtt.enums import CallbackAPIVersion
 
 from app import timing
-from app.cell.cell_file import Cell
+from app.cell.cell_file import Cell, CellController
+from app.cell.history import program_cycle
 from app.gateway import payload as pb
+from app.gateway.bdseq import BdSeqStore
 from app.gateway.metrics import (
+    ALL_METRICS,
     BDSEQ,
-    DEVICE_METRICS,
+    COMMAND_WRITES,
+    CYCLE_METRICS,
     HISTORY_DROPPED,
+    PLANT_RESULT,
     REBIRTH,
     REBIRTH_ALIAS,
     Reading,
     changed,
     clock_text,
     device_alias,
+    device_metrics,
     device_values,
 )
+from app.gateway.plant import PlantCommand, PlantWriter, plant_audit_role
 from app.gateway.poller import ControllerPoller, GatewayTiming
+from app.safety.audit import AuditLog
+from app.safety.envelope import Envelope
 
 __all__ = ["NAMESPACE", "BrokerSettings", "EdgeNode"]
 
@@ -80,12 +100,23 @@ class BrokerSettings:
     password: str | None = None
 
 
+def _kept() -> dict[str, pb.Value]:
+    """What the node holds of a device beside its polls: the cycle counters and the plant's metrics."""
+    kept: dict[str, pb.Value] = dict.fromkeys(CYCLE_METRICS.values(), 0)
+    kept.update({PLANT_RESULT: "", "Plant/Program run": None, "Plant/Program stop": False})
+    kept["Plant/Speed ratio"] = None
+    return kept
+
+
 @dataclass
 class _Device:
     """What the node knows of one controller (guarded by the node's lock)."""
 
     name: str
     index: int
+    metrics: tuple[int, ...]  # its metrics' indexes in ALL_METRICS (app.gateway.metrics.device_metrics)
+    kept: dict[str, pb.Value] = field(default_factory=_kept)
+    commands: int = 0  # DCMD metrics received (their numbers)
     alive: bool = False  # answering (a DBIRTH went out, or will on the next session)
     values: dict[str, pb.Value] | None = None  # the last reading's values
     sent: dict[str, pb.Value] | None = None  # what the subscribers were last told
@@ -111,18 +142,33 @@ class EdgeNode:
         deadbands: Mapping[str, float] | None = None,
         history_limit: int | None = None,
         primary_host: str | None = None,
+        bdseq_file: str | os.PathLike[str] | None = None,
+        envelope: Envelope | None = None,
+        audit_dir: Path | None = None,
+        writes: bool = True,
     ) -> None:
+        """``envelope``: the plant writes' safety envelope (None: the one in force, as the CLI's, read
+        when a controller has plant writes); ``audit_dir``: their audit trail (None: TeachPad's);
+        ``writes``: False leaves every robot monitor-only whatever the cell file enables."""
         self.group = group
         self.node = node
         self.timing = gateway or GatewayTiming()
         self._deadbands = dict(deadbands or {})
         self._broker = broker
         self._lock = threading.RLock()
-        self._devices = {c.name: _Device(c.name, i) for i, c in enumerate(cell.controllers)}
+        self._envelope = envelope
+        self._audit_dir = audit_dir
+        self._writes = writes
+        self._pendant_robot: str | None = None
+        self._writers: dict[str, PlantWriter] = {}
+        self._read_envelope(cell.controllers)
+        self._devices = {c.name: self._device(c, i) for i, c in enumerate(cell.controllers)}
         self._controllers = {c.name: c for c in cell.controllers}
-        self._pollers = {c.name: ControllerPoller(c, self, self.timing) for c in cell.controllers}
+        self._pollers = {c.name: self._poller(c) for c in cell.controllers}
         self._next_index = len(cell.controllers)  # a controller that joins later: aliases never reused
-        self.bdseq = 0
+        # the last session's bdSeq + 1 when kept in a file (a restart is a new session too), else 0
+        self._bdseq_store = None if bdseq_file is None else BdSeqStore(bdseq_file, group, node)
+        self.bdseq = 0 if self._bdseq_store is None else self._bdseq_store.first()
         self._seq = 0
         self._online = False  # an MQTT session is up and NBIRTH went out
         self.sessions = 0  # MQTT sessions so far (NBIRTHs after a connect)
@@ -138,6 +184,38 @@ class EdgeNode:
         self._history: deque[tuple[str, Any]] = deque(maxlen=max(1, limit))
         self.history_dropped = 0  # DDATA the bound dropped while the broker was away, since the start
         self._client = self._make_client()
+
+    def _read_envelope(self, controllers: tuple[CellController, ...]) -> None:
+        """The safety envelope in force (the GUI's and the CLI's), read once when a robot has plant
+        writes (before anything changes: one that cannot be read raises, nothing is half made)."""
+        if self._envelope is None and self._writes and any(c.plant_writes for c in controllers):
+            from app.cli.guard import envelope_in_force
+
+            self._envelope = envelope_in_force()
+
+    def _allowed(self, controller: CellController) -> CellController:
+        """``controller`` as this node serves it: without plant writes when ``writes`` is off."""
+        return controller if self._writes else dataclasses.replace(controller, plant_writes=())
+
+    def _device(self, controller: CellController, index: int) -> _Device:
+        return _Device(controller.name, index, device_metrics(self._allowed(controller)))
+
+    def _poller(self, controller: CellController) -> ControllerPoller:
+        """Its poller, and its plant writer (which refuses what is not enabled; the poller only
+        makes a client that can write when something is)."""
+        writer = self._writers[controller.name] = self._writer(controller)
+        return ControllerPoller(controller, self, self.timing, writer)
+
+    def _writer(self, controller: CellController) -> PlantWriter:
+        name = controller.name
+        controller = self._allowed(controller)
+        audit = AuditLog(self._audit_dir, role=plant_audit_role(name))
+        return PlantWriter(controller, self._envelope, audit, self, lambda: self._pendant_robot == name)
+
+    def set_pendant_robot(self, name: str | None) -> None:
+        """The robot this TeachPad's pendant commands now (the GUI's Take control; None: none): the
+        plant's writes to it are refused meanwhile."""
+        self._pendant_robot = name
 
     # -- topics ---------------------------------------------------------------------------
     def topic(self, kind: str, device: str | None = None) -> str:
@@ -169,6 +247,9 @@ class EdgeNode:
         return client
 
     def _set_will(self, client: mqtt.Client) -> None:
+        """The session's will (its bdSeq: kept in the file first, when there is one)."""
+        if self._bdseq_store is not None:
+            self._bdseq_store.save(self.bdseq)
         client.will_set(self.topic("NDEATH"), self._ndeath(), qos=1, retain=False)
 
     def _ndeath(self) -> bytes:
@@ -208,6 +289,7 @@ class EdgeNode:
         """The cell file changed: a controller that left (or whose settings changed) gets its DDEATH
         and its poller stops; one that joined gets a poller (and its DBIRTH at its first answer, with
         aliases of its own: a device index is never used twice)."""
+        self._read_envelope(cell.controllers)
         wanted = {c.name: c for c in cell.controllers}
         with self._lock:
             leaving = [n for n, c in self._controllers.items() if wanted.get(n) != c]
@@ -217,16 +299,17 @@ class EdgeNode:
                 kept = [(t, m) for t, m in self._history if t not in topics]
                 self._history = deque(kept, maxlen=self._history.maxlen)
             for name in leaving:
+                self._writers.pop(name, None)
                 state = self._devices.pop(name)
                 del self._controllers[name]
                 if state.alive and self._online:
                     self._publish(self.topic("DDEATH", name), pb.Payload(timestamp=_now_ms()))
             joining = [c for n, c in wanted.items() if n not in self._controllers]
             for controller in joining:
-                self._devices[controller.name] = _Device(controller.name, self._next_index)
+                self._devices[controller.name] = self._device(controller, self._next_index)
                 self._next_index += 1
                 self._controllers[controller.name] = controller
-                self._pollers[controller.name] = ControllerPoller(controller, self, self.timing)
+                self._pollers[controller.name] = self._poller(controller)
         for poller in stopped:  # outside the lock: its thread may be waiting for it
             poller.stop()
         if self._running:
@@ -240,6 +323,7 @@ class EdgeNode:
             _log.warning("broker refused the connection: %s", reason)
             return
         client.subscribe(self.topic("NCMD"), qos=1)
+        client.subscribe(self.topic("DCMD", "+"), qos=1)
         if self.primary_host is not None:
             client.subscribe(self._state_topic(), qos=1)
         if self._unreachable_said:
@@ -330,6 +414,10 @@ class EdgeNode:
         if self.primary_host is not None and message.topic == self._state_topic():
             self._on_state(bytes(message.payload))
             return
+        dcmd = self.topic("DCMD") + "/"
+        if message.topic.startswith(dcmd):
+            self._on_dcmd(message.topic[len(dcmd) :], bytes(message.payload))
+            return
         if message.topic != self.topic("NCMD"):
             return
         try:
@@ -344,6 +432,58 @@ class EdgeNode:
                 with self._lock:
                     if self._online:
                         self._birth()
+
+    def _on_dcmd(self, device: str, data: bytes) -> None:
+        """A write from the plant: each metric to the robot's plant writer (refused there when not
+        enabled; refused here when the robot does not answer)."""
+        try:
+            payload = pb.decode(data)
+        except DecodeError as exc:
+            _log.warning("DCMD for %s not understood: %s", device, exc)
+            return
+        with self._lock:
+            state, writer = self._devices.get(device), self._writers.get(device)
+            if state is None or writer is None:
+                _log.warning("DCMD for %r, not a controller of the cell: ignored", device)
+                return
+            commands = []
+            for metric in payload.metrics:
+                state.commands += 1
+                write = self._write_named(state, metric)
+                commands.append(
+                    PlantCommand(state.commands, write, pb.metric_value(metric), time.monotonic())
+                )
+            alive = state.alive
+        for command in commands:
+            _log.warning("plant command for %s: %s", device, command.text)
+            if alive:
+                writer.submit(command)
+            else:
+                writer.refuse(command, f"{device} does not answer")
+
+    @staticmethod
+    def _write_named(state: _Device, metric: Any) -> str:
+        """The cell file's name of the write a DCMD metric asks for (by name, or by its alias)."""
+        name = str(metric.name)
+        if not name:
+            found = [i for i in state.metrics if device_alias(state.index, i) == metric.alias]
+            name = ALL_METRICS[found[0]].name if found else f"alias {metric.alias}"
+        return COMMAND_WRITES.get(name, name)
+
+    def plant_said(self, device: str, text: str, values: Mapping[str, pb.Value]) -> None:
+        """What became of a plant command (:class:`~app.gateway.plant.PlantListener`): the device's
+        ``Plant/Last command result`` and the written metrics' values, in a DDATA."""
+        _log.warning("%s: %s", device, text)
+        with self._lock:
+            state = self._devices.get(device)
+            if state is None:
+                return
+            state.kept[PLANT_RESULT] = text
+            state.kept.update(values)
+            if state.values is not None:
+                state.values.update(state.kept)
+                if state.alive and state.sent is not None:
+                    self._ddata(state, _now_ms())
 
     # -- publishing (under the lock) ------------------------------------------------------
     def _publish(self, topic: str, message: Any) -> None:
@@ -393,7 +533,8 @@ class EdgeNode:
     def _dbirth(self, device: _Device, stamp: int) -> None:
         assert device.values is not None
         message = pb.Payload(timestamp=stamp)
-        for i, spec in enumerate(DEVICE_METRICS):
+        for i in device.metrics:
+            spec = ALL_METRICS[i]
             metric = message.metrics.add(
                 name=spec.name, alias=device_alias(device.index, i), timestamp=stamp, datatype=spec.datatype
             )
@@ -418,7 +559,8 @@ class EdgeNode:
         """A DDATA payload of what moved past its deadband since the last one (None: nothing)."""
         assert device.values is not None and device.sent is not None
         message = pb.Payload(timestamp=stamp)
-        for i, spec in enumerate(DEVICE_METRICS):
+        for i in device.metrics:
+            spec = ALL_METRICS[i]
             now = device.values[spec.name]
             if changed(spec, device.sent[spec.name], now, self._deadbands):
                 metric = message.metrics.add(alias=device_alias(device.index, i), timestamp=stamp)
@@ -436,13 +578,25 @@ class EdgeNode:
             if reading.clock is not None:
                 state.clock = clock_text(reading.clock)
             freshness = int((time.monotonic() - reading.answered_at) * 1000)
-            state.values = device_values(reading, freshness, state.clock)
+            self._count_cycle(state, reading)
+            state.values = device_values(reading, freshness, state.clock, state.kept)
             if not state.alive:
                 state.alive = True
                 if self._online:
                     self._dbirth(state, reading.wall_ms)
             elif state.sent is not None:  # births told the subscribers its values once
                 self._ddata(state, reading.wall_ms)
+
+    @staticmethod
+    def _count_cycle(state: _Device, reading: Reading) -> None:
+        """The program cycle counters (app/cell/history.py's rule, from the program-state register)."""
+        if state.values is None:
+            return
+        before, status = state.values["Status/Program state"], reading.status
+        cycle = program_cycle(int(before or 0), int(status.program_state), int(status.alarms))
+        if cycle is not None:
+            name = CYCLE_METRICS[cycle]
+            state.kept[name] = int(state.kept[name] or 0) + 1
 
     def silent(self, device: str, reason: str) -> None:
         with self._lock:

@@ -2,12 +2,23 @@
 
 A device's metrics are what one poll of the controller gives -- the status block (560..583, with
 the clock every :data:`app.timing.GATEWAY_CLOCK_PERIOD`) and the pose block (GV206..GV255) -- plus
-the poller's own link figures. Not published (the reads the gateway makes do not give them): the
-cycle counter (no register in PROTOCOL.md's tables), the external axes E1..E5 (in the pose block,
-but nothing says which a controller has), and the controller's temperature, firmware or program id.
+the poller's own link figures and what the gateway counts and says:
+
+* **always** (:data:`DEVICE_METRICS`): pose, joints, mode, program state, alarms, GV291, link
+  figures, the controller's clock, the program cycles counted from the program-state register
+  (561) by :func:`app.cell.history.program_cycle` -- started, finished, stopped -- since the gateway
+  started watching the robot (the controller has no cycle register), and ``Plant/Last command
+  result`` (what became of the last DCMD, in words, numbered: ``#3 program/run 7: done ...``);
+* **where present** (:data:`EXTERNAL_METRICS`): the external axes E1..E5 (GV212..GV216, the GUI's
+  J7..J11), as many as the cell file's ``external_axes`` says the robot has;
+* **where enabled** (:data:`COMMAND_METRICS`): the writable metrics, one per ``plant_writes`` entry
+  of the cell file -- the DBIRTH advertises exactly these, a DCMD writes them.
+
+Not published: the controller's temperature, firmware or program id (no register for them).
 
 Aliases are unique over the edge node: the node's ``Node Control/Rebirth`` is 1, device ``d``
-(0-based, in the cell file's order) has ``1000 * (d + 1) + i`` for its ``i``-th metric.
+(0-based, in the cell file's order) has ``1000 * (d + 1) + i`` for metric ``i`` of
+:data:`ALL_METRICS` (the same alias whichever of them a device has).
 """
 
 from __future__ import annotations
@@ -16,18 +27,44 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+from app.cell.cell_file import CellController
 from app.gateway.payload import DataType, Value
 from app.models import ControllerStatus, Pose
 from app.protocol.datetime_regs import ControllerClock
 from app.protocol.enums import ALARM_BITS, Alarm
 
-__all__ = ["DEVICE_METRICS", "REBIRTH", "MetricSpec", "changed", "device_alias", "device_values"]
+__all__ = [
+    "ALL_METRICS",
+    "COMMAND_METRICS",
+    "DEVICE_METRICS",
+    "EXTERNAL_METRICS",
+    "REBIRTH",
+    "MetricSpec",
+    "changed",
+    "device_alias",
+    "device_metrics",
+    "device_values",
+]
 
 REBIRTH = "Node Control/Rebirth"
 REBIRTH_ALIAS = 1
 BDSEQ = "bdSeq"
 HISTORY_DROPPED = "Node Info/History dropped"
 ALIAS_BLOCK = 1000
+PLANT_RESULT = "Plant/Last command result"
+#: the cycle counters, by the word of :func:`app.cell.history.program_cycle`
+CYCLE_METRICS: dict[str, str] = {
+    "started": "Program/Cycles started",
+    "finished": "Program/Cycles finished",
+    "stopped": "Program/Cycles stopped",
+}
+#: the writable metrics and the cell file's name of each (app.safety.roles.PLANT_WRITES)
+COMMAND_WRITES: dict[str, str] = {
+    "Plant/Program run": "program/run",
+    "Plant/Program stop": "program/stop",
+    "Plant/Speed ratio": "speed_ratio",
+}
+WRITE_METRICS: dict[str, str] = {write: name for name, write in COMMAND_WRITES.items()}
 
 ALARM_METRIC_NAMES: dict[Alarm, str] = {
     Alarm.ESTOP: "Alarms/Emergency stop",
@@ -67,11 +104,29 @@ def _specs() -> tuple[MetricSpec, ...]:
         MetricSpec("Link/Errors", DataType.UINT64),
         MetricSpec("Controller/Clock", DataType.STRING),
     ]
-    return (*pose, *joints, *state, *alarms, *link)
+    cycles = [MetricSpec(name, DataType.UINT64) for name in CYCLE_METRICS.values()]
+    return (*pose, *joints, *state, *alarms, *link, *cycles, MetricSpec(PLANT_RESULT, DataType.STRING))
 
 
 DEVICE_METRICS: tuple[MetricSpec, ...] = _specs()
-METRIC_INDEX: dict[str, int] = {spec.name: i for i, spec in enumerate(DEVICE_METRICS)}
+EXTERNAL_METRICS: tuple[MetricSpec, ...] = tuple(
+    MetricSpec(f"External/E{i}", DataType.DOUBLE, 0.01, "mm or deg") for i in range(1, 6)
+)
+COMMAND_METRICS: tuple[MetricSpec, ...] = (
+    MetricSpec("Plant/Program run", DataType.UINT16),  # the program id to run (446, then 440 <- 1)
+    MetricSpec("Plant/Program stop", DataType.BOOLEAN),  # true: stop (441 <- 1)
+    MetricSpec("Plant/Speed ratio", DataType.UINT16, unit="%"),  # the program speed ratio (449), 1..100
+)
+ALL_METRICS: tuple[MetricSpec, ...] = (*DEVICE_METRICS, *EXTERNAL_METRICS, *COMMAND_METRICS)
+METRIC_INDEX: dict[str, int] = {spec.name: i for i, spec in enumerate(ALL_METRICS)}
+
+
+def device_metrics(controller: CellController) -> tuple[int, ...]:
+    """The indexes (in :data:`ALL_METRICS`) of the metrics ``controller``'s device has, in order."""
+    names = [spec.name for spec in DEVICE_METRICS]
+    names += [spec.name for spec in EXTERNAL_METRICS[: controller.external_axes]]
+    names += [spec.name for spec in COMMAND_METRICS if COMMAND_WRITES[spec.name] in controller.plant_writes]
+    return tuple(METRIC_INDEX[name] for name in names)
 
 
 def device_alias(device_index: int, metric_index: int) -> int:
@@ -98,8 +153,11 @@ class Reading:
     wall_ms: int  # the same moment as ms since the epoch (the metrics' timestamp)
 
 
-def device_values(reading: Reading, freshness_ms: int, clock: str | None) -> dict[str, Value]:
-    """Every metric's value for ``reading`` (the names of :data:`DEVICE_METRICS`)."""
+def device_values(
+    reading: Reading, freshness_ms: int, clock: str | None, kept: Mapping[str, Value]
+) -> dict[str, Value]:
+    """Every metric's value for ``reading`` (the names of :data:`ALL_METRICS`): what the poll read,
+    and ``kept``, what the gateway holds of the device (the cycle counters, the plant's metrics)."""
     pose, status = reading.pose, reading.status
     joints = pose.joints or (math.nan,) * 6
     values: dict[str, Value] = {f"Pose/{axis}": v for axis, v in zip("XYZABC", pose.xyzabc, strict=True)}
@@ -118,6 +176,8 @@ def device_values(reading: Reading, freshness_ms: int, clock: str | None) -> dic
         }
     )
     values.update({ALARM_METRIC_NAMES[bit]: bool(alarms & bit) for bit in ALARM_BITS})
+    values.update({spec.name: float(v) for spec, v in zip(EXTERNAL_METRICS, pose.ext, strict=True)})
+    values.update(kept)
     return values
 
 

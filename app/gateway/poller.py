@@ -1,12 +1,14 @@
 """One controller's poller for the gateway: its own thread, client, timeouts and backoff.
 
-Monitor-only: the :class:`~app.link.client.RobotClient` is made with ``monitor_only=True`` (the one
-write guard refuses every write) and the poller only reads -- the status block (with the clock every
-:attr:`GatewayTiming.clock_period`), then the pose block, each with the poll timeout
-(``settings.effective_poll_timeout``: 0.15 s over TCP). A poll that fails (no answer in time, a
-refused or lost connection, a malformed answer) is reported at once (:meth:`DeviceListener.silent`),
-and the next tries come after :attr:`GatewayTiming.backoff`; a dead controller costs the others
-nothing (each has its own thread and link).
+Monitor-only unless the plant may write to the controller: the :class:`~app.link.client.RobotClient`
+is made with ``monitor_only=True`` (the one write guard refuses every write); with plant writes
+enabled in the cell file it is writable, audited, and its :class:`~app.gateway.plant.PlantWriter`
+makes the plant's commands between two polls (:mod:`app.gateway.plant`). The poller reads the
+status block (with the clock every :attr:`GatewayTiming.clock_period`), then the pose block, each
+with the poll timeout (``settings.effective_poll_timeout``: 0.15 s over TCP). A poll that fails
+(no answer in time, a refused or lost connection, a malformed answer) is reported at once
+(:meth:`DeviceListener.silent`), and the next tries come after :attr:`GatewayTiming.backoff`; a
+dead controller costs the others nothing (each has its own thread and link).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ from app import timing
 from app.cell.cell_file import CellController
 from app.errors import TeachPadError
 from app.gateway.metrics import Reading
+from app.gateway.plant import PlantWriter
 from app.link.client import RobotClient
 from app.protocol.datetime_regs import ControllerClock
 
@@ -58,12 +61,23 @@ class DeviceListener(Protocol):
 class ControllerPoller:
     """Polls one controller until :meth:`stop`; tells ``listener`` every answer and every failure."""
 
-    def __init__(self, controller: CellController, listener: DeviceListener, gateway: GatewayTiming) -> None:
+    def __init__(
+        self,
+        controller: CellController,
+        listener: DeviceListener,
+        gateway: GatewayTiming,
+        writer: PlantWriter | None = None,
+    ) -> None:
         self.name = controller.name
-        settings = controller.settings(monitor_only=True)
+        # monitor-only (the write guard refuses every write) unless the plant may write to it
+        self.writer = writer if writer is not None and writer.enabled else None
+        settings = controller.settings(monitor_only=self.writer is None)
         if gateway.poll_timeout is not None:
             settings = dataclasses.replace(settings, poll_timeout=gateway.poll_timeout)
         self._client = RobotClient(settings)
+        if self.writer is not None:
+            self._client.audit = self.writer.audit  # every write recorded, as the pendant's
+            self._client.watch_shared_every = timing.CLOCK_POLL_PERIOD  # another master's writes
         self._listener = listener
         self._timing = gateway
         self._stop = threading.Event()
@@ -107,6 +121,8 @@ class ControllerPoller:
         try:
             if not client.connected:
                 client.connect()
+                if self.writer is not None:
+                    client.watch_shared_baseline()  # another master's writes are told from here on
             clock = self._read(client)
         except TeachPadError as exc:
             self.errors += 1
@@ -135,4 +151,6 @@ class ControllerPoller:
             wall_ms=int(time.time() * 1000),
         )
         self._listener.answered(self.name, reading)
+        if self.writer is not None:
+            self.writer.after_poll(client, status, pose)
         return status.clock

@@ -21,7 +21,7 @@ from __future__ import annotations
 import enum
 import json
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Collection
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -104,6 +104,31 @@ REQUIRED_ROLE: dict[Action, Role] = {
     Action.MANAGE_ROLES: Role.ADMINISTRATOR,
     Action.WRITE_REGISTERS: Role.ADMINISTRATOR,
 }
+
+
+#: The **plant** role: a Sparkplug host application writing through ``teachpad-gateway`` (a DCMD).
+#: Not a login role of the pendant (no password, not in :class:`Role`): it may do only the writes
+#: named here, each only where an administrator enabled it for one robot (the cell file's
+#: ``plant_writes``); nothing is enabled by default. Its audit records say ``plant (ROBOT)``.
+PLANT_ROLE = "plant"
+PLANT_WRITES: dict[str, Action] = {
+    "program/run": Action.RUN_PROGRAM,
+    "program/stop": Action.STOP,
+    "speed_ratio": Action.RUN_PROGRAM,  # the program speed ratio (449)
+}
+
+
+def plant_reason(write: str, enabled: Collection[str]) -> str | None:
+    """None when the plant may make ``write`` (it is one of :data:`PLANT_WRITES` and ``enabled``);
+    else why not, in words."""
+    if write not in PLANT_WRITES:
+        return f"{write} is not a write the plant may make ({', '.join(PLANT_WRITES)})"
+    if write not in enabled:
+        return (
+            f"{write} is not enabled for this robot "
+            "(an administrator enables it in the cell file's plant_writes)"
+        )
+    return None
 
 
 def allowed(role: Role, action: Action) -> bool:

@@ -112,6 +112,22 @@ def test_saved_atomically_and_read_back_the_same(tmp_path: Path, monkeypatch: py
         ({"name": "R2", "host": "h", "robot_profile": "none.json"}, "controller 'R2': robot_profile:"),
         ({"name": "R1", "host": "h"}, "controller 'R1': name is used twice"),
         ("R2", "controller 2: must be an object"),
+        (
+            {"name": "R2", "host": "h", "plant_writes": "program/run"},
+            "controller 'R2': plant_writes must be a list of names",
+        ),
+        (
+            {"name": "R2", "host": "h", "plant_writes": ["program/run", "jog"]},
+            "controller 'R2': plant_writes: \"jog\" is not a write the plant may make",
+        ),
+        (
+            {"name": "R2", "host": "h", "plant_writes": ["speed_ratio", "speed_ratio"]},
+            "controller 'R2': plant_writes names a write twice",
+        ),
+        (
+            {"name": "R2", "host": "h", "external_axes": 6},
+            "controller 'R2': external_axes must be a whole number 0..5",
+        ),
     ],
 )
 def test_a_problem_is_one_line_naming_the_controller_and_the_field(
@@ -146,3 +162,20 @@ def test_a_bad_file_says_so_in_one_line(tmp_path: Path, doc: Any, said: str) -> 
 def test_a_missing_file_is_named(tmp_path: Path) -> None:
     with pytest.raises(CellFileError, match="does not exist"):
         load_cell(tmp_path / "nowhere.json")
+
+
+def test_plant_writes_and_external_axes_are_read_and_written_back(tmp_path: Path) -> None:
+    writes = ["program/run", "program/stop", "speed_ratio"]
+    path = _write(
+        tmp_path,
+        _doc(
+            {"name": "R1", "host": "h"},
+            {"name": "R2", "host": "h", "external_axes": 2, "plant_writes": writes},
+        ),
+    )
+    cell = load_cell(path)
+    assert (cell.controllers[0].plant_writes, cell.controllers[0].external_axes) == ((), 0)  # off by default
+    assert (cell.controllers[1].plant_writes, cell.controllers[1].external_axes) == (tuple(writes), 2)
+    save_cell(path, cell)
+    assert load_cell(path) == cell
+    assert "plant_writes" not in json.loads(path.read_text())["controllers"][0]

@@ -232,12 +232,21 @@ def subscriber(broker: Broker) -> Iterator[Subscriber]:
         sub.close()
 
 
-def write_cell(folder: Path, sims: dict[str, Any], name: str = "test cell") -> Path:
-    """A cell file with one controller per simulator (its name -> the simulator), written by the product."""
+def write_cell(
+    folder: Path,
+    sims: dict[str, Any],
+    name: str = "test cell",
+    options: dict[str, dict[str, Any]] | None = None,
+) -> Path:
+    """A cell file with one controller per simulator (its name -> the simulator), written by the
+    product; ``options``: more fields of a controller by its name (``plant_writes``, ``external_axes``)."""
     from app.cell.cell_file import Cell, CellController, save_cell
 
     path = folder / "cell.json"
-    controllers = tuple(CellController(n, host="127.0.0.1", port=sim.port) for n, sim in sims.items())
+    more = options or {}
+    controllers = tuple(
+        CellController(n, host="127.0.0.1", port=sim.port, **more.get(n, {})) for n, sim in sims.items()
+    )
     save_cell(path, Cell(name, controllers))
     return path
 
@@ -252,6 +261,7 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
     from app.cell.cell_file import load_cell
     from app.gateway.edge_node import BrokerSettings, EdgeNode
     from app.gateway.poller import GatewayTiming
+    from app.safety.envelope import Envelope
 
     made: list[EdgeNode] = []
 
@@ -261,9 +271,12 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
         history_limit: int | None = None,
         port: int | None = None,
         primary_host: str | None = None,
+        bdseq_file: Path | None = None,
+        options: dict[str, dict[str, Any]] | None = None,
+        envelope: Any = None,
         **clocks: Any,
     ) -> EdgeNode:
-        cell = load_cell(write_cell(tmp_path, sims))
+        cell = load_cell(write_cell(tmp_path, sims, options=options))
         node = EdgeNode(
             cell,
             BrokerSettings("127.0.0.1", port or broker.port),
@@ -273,6 +286,10 @@ def gateway_factory(broker: Broker, tmp_path: Path) -> Iterator[Callable[..., An
             deadbands=deadbands,
             history_limit=history_limit,
             primary_host=primary_host,
+            bdseq_file=bdseq_file,
+            # the test's own envelope (the one in force is the session's: another test may save one)
+            envelope=envelope if envelope is not None else Envelope(),
+            audit_dir=tmp_path / "audit",
         )
         node.start()
         made.append(node)

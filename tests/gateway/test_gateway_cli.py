@@ -15,6 +15,7 @@ import pytest
 
 from app.gateway import payload as pb
 from app.gateway.cli import main
+from app.gateway.metrics import METRIC_INDEX, PLANT_RESULT, device_alias
 from tests.waits import kill_child, read_line, wait_child
 
 from .conftest import Subscriber, write_cell
@@ -139,3 +140,50 @@ def test_sighup_reads_the_cell_file_again(
         assert wait_child(proc, "teachpad-gateway after SIGTERM") == 0
     finally:
         kill_child(proc)
+
+
+def test_monitor_only_writes_nothing_whatever_the_cell_file_enables(
+    sim_factory: Any, broker: Any, subscriber: Subscriber, tmp_path: Path
+) -> None:
+    sim = sim_factory()
+    writes = {"plant_writes": ["program/run", "program/stop", "speed_ratio"]}
+    cell = write_cell(tmp_path, {"R1": sim}, options={"R1": writes})
+    proc = _start(cell, broker.port, "--monitor-only", "--bdseq-file", str(tmp_path / "b.json"))
+    try:
+        birth = subscriber.kind("DBIRTH", "R1", timeout=30.0)
+        assert not [
+            m for m in birth.payload.metrics if m.name.startswith("Plant/") and m.name != PLANT_RESULT
+        ]
+        start = subscriber.count()
+        command = pb.Payload(timestamp=int(time.time() * 1000))
+        pb.set_value(
+            command.metrics.add(name="Plant/Program run", datatype=pb.DataType.UINT16), pb.DataType.UINT16, 2
+        )
+        subscriber.publish("spBv1.0/plant/DCMD/pad9/R1", pb.encode(command))
+        result = device_alias(0, METRIC_INDEX[PLANT_RESULT])
+        said = subscriber.wait_for(
+            "the refusal",
+            lambda m: m.kind == "DDATA" and any(x.alias == result for x in m.payload.metrics),
+            start=start,
+        )
+        text = next(pb.metric_value(x) for x in said.payload.metrics if x.alias == result)
+        assert "refused: program/run is not enabled" in str(text)
+        proc.send_signal(signal.SIGTERM)
+        assert wait_child(proc, "teachpad-gateway after SIGTERM") == 0
+    finally:
+        kill_child(proc)
+    assert sim.writes == []
+
+
+def test_an_envelope_that_cannot_be_read_when_plant_writes_need_it_is_one_line_and_exit_2(
+    sim_factory: Any, tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "config"))
+    envelope = tmp_path / "config" / "teachpad" / "envelope.safety.json"
+    envelope.parent.mkdir(parents=True)
+    envelope.write_text("{")
+    cell = write_cell(tmp_path, {"R1": sim_factory()}, options={"R1": {"plant_writes": ["speed_ratio"]}})
+    err = _usage(
+        capsys, str(cell), "--broker", "mqtt://127.0.0.1:1", "--bdseq-file", str(tmp_path / "b.json")
+    )
+    assert "envelope.safety.json" in err

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import math
 
-from app.gateway.metrics import DEVICE_METRICS, METRIC_INDEX, changed, device_alias
+from app.gateway.metrics import ALL_METRICS, DEVICE_METRICS, METRIC_INDEX, changed, device_alias
 
 POSE_X = DEVICE_METRICS[METRIC_INDEX["Pose/X"]]  # deadband 0.01 mm
 MODE = DEVICE_METRICS[METRIC_INDEX["Status/Work mode"]]
@@ -33,6 +33,6 @@ def test_null_and_nan() -> None:
 
 
 def test_aliases_are_unique_over_the_node() -> None:
-    aliases = {device_alias(d, i) for d in range(256) for i in range(len(DEVICE_METRICS))}
-    assert len(aliases) == 256 * len(DEVICE_METRICS)
+    aliases = {device_alias(d, i) for d in range(256) for i in range(len(ALL_METRICS))}
+    assert len(aliases) == 256 * len(ALL_METRICS)
     assert 1 not in aliases  # Node Control/Rebirth's
