@@ -200,8 +200,9 @@ def test_the_bundle_smokes_gateway_step_passes_with_the_venvs_gateway(tmp_path: 
         x = sim.state().pose[0]
     finally:
         sim.stop()
-    assert facts["exit"] == 0 and facts["ndeath_bdSeq"] == facts["bdSeq"]
     assert facts["pose_x"] == pytest.approx(x, abs=0.01)
+    if sys.platform != "win32":  # terminate() there is TerminateProcess: no clean stop, no NDEATH
+        assert facts["exit"] == 0 and facts["ndeath_bdSeq"] == facts["bdSeq"]
     assert [s["step"] for s in steps] == ["teachpad-gateway --version", "teachpad-gateway -> mosquitto"]
 
 

@@ -194,7 +194,7 @@ def check_png(path: Path) -> dict[str, Any]:
 
 
 # --- the gateway: a real Mosquitto, an independent subscriber ------------------------------------
-MOSQUITTO_PATHS = ("/usr/sbin/mosquitto", "/usr/bin/mosquitto")
+MOSQUITTO_PATHS = ("/usr/sbin/mosquitto", "/usr/bin/mosquitto", r"C:\Program Files\mosquitto\mosquitto.exe")
 BROKER_START_TIMEOUT = 10.0  # s for mosquitto to accept connections
 GATEWAY_TIMEOUT = 60.0  # s for the bundle's gateway to start and publish its births (cold, loaded)
 GROUP, NODE, DEVICE = "smoke", "bundle", "R1"
@@ -205,7 +205,7 @@ def mosquitto_binary() -> str:
     if found is None:
         raise SmokeFailure(
             "mosquitto is not installed: the gateway's smoke needs a real MQTT broker "
-            "(Debian: apt-get install -y mosquitto; .ci/run installs it)"
+            "(Debian: apt-get install -y mosquitto, .ci/run installs it; Windows: choco install mosquitto)"
         )
     return found
 
