@@ -80,8 +80,8 @@ translations: $(STAMP)
 	$(BIN)/pyside6-lrelease resources/translations/teachpad_zh_CN.ts -qm ui/i18n/teachpad_zh_CN.qm
 
 # The bundle that needs no Python (README, "Bundle"): dist/teachpad/ holds the executables
-# teachpad, teachpad-cli and teachpad-sim over one _internal/ folder (Qt, numpy, Python, the
-# translations, the robot profiles). PyInstaller is pinned in pyproject.toml's `dist` extra.
+# teachpad, teachpad-cli, teachpad-sim and teachpad-gateway over one _internal/ folder (Qt, numpy,
+# Python, paho-mqtt, protobuf, the translations, the robot profiles, the gateway's .proto). PyInstaller is pinned in pyproject.toml's `dist` extra.
 # `make dist-smoke` runs the bundle from a clean environment (tools/dist_smoke.py).
 DIST_STAMP := $(VENV)/.dist-stamp
 $(DIST_STAMP): $(STAMP)

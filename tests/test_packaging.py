@@ -7,11 +7,13 @@ The bundle itself is built and run by `.ci/run` (tools/dist_smoke.py: minutes, n
 from __future__ import annotations
 
 import ast
+import importlib.util
 import json
 import os
 import subprocess
 import sys
 from pathlib import Path
+from typing import Any
 
 import pytest
 
@@ -122,7 +124,86 @@ def test_the_spec_collects_the_files_the_code_reads_at_their_package_paths() -> 
     assert "app/view3d/profiles" in targets
     assert (ROOT / "app" / "view3d" / "profiles" / DEFAULT_PROFILE_FILE).is_file()
     launchers = sorted(p.stem for p in (ROOT / "packaging" / "launchers").glob("*.py"))
-    assert launchers == ["teachpad", "teachpad-cli", "teachpad-sim"]
+    assert launchers == ["teachpad", "teachpad-cli", "teachpad-gateway", "teachpad-sim"]
+
+
+def _spec_data_targets() -> dict[str, str]:
+    """The spec's DATAS as {source path relative to the repository: folder in the bundle}."""
+    tree = ast.parse(SPEC.read_text("utf-8"))
+    datas = next(
+        n.value
+        for n in tree.body
+        if isinstance(n, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "DATAS" for t in n.targets)
+    )
+    assert isinstance(datas, ast.List)
+    out: dict[str, str] = {}
+    for entry in datas.elts:
+        if isinstance(entry, ast.Tuple):
+            source = entry.elts[0]
+            assert isinstance(source, ast.Call)  # str(ROOT / "a" / "b" ...)
+            parts = [ast.literal_eval(n.right) for n in ast.walk(source) if isinstance(n, ast.BinOp)]
+            out["/".join(reversed(parts))] = ast.literal_eval(entry.elts[1])
+    return out
+
+
+def test_the_bundle_has_every_console_script_and_the_smoke_runs_each() -> None:
+    """pyproject.toml's console scripts (teachpad-gateway among them: a plant PC without Python runs
+    it) are the spec's executables, each with its launcher, and tools/dist_smoke.py runs each one."""
+    import tomllib
+
+    with open(ROOT / "pyproject.toml", "rb") as f:
+        scripts = sorted(tomllib.load(f)["project"]["scripts"])
+    assert "teachpad-gateway" in scripts
+    assert sorted(_spec_list("NAMES")) == scripts
+    assert sorted(p.stem for p in (ROOT / "packaging" / "launchers").glob("*.py")) == scripts
+    assert sorted(_dist_smoke().EXECUTABLES) == scripts
+
+
+def test_the_spec_collects_the_gateways_proto_where_the_payload_reads_it() -> None:
+    """app.gateway.payload parses sparkplug_b.proto beside it when imported: without that file in
+    the bundle's app/gateway/ the bundle's teachpad-gateway dies at start (even --version)."""
+    from app.gateway.payload import PROTO_FILE
+
+    assert PROTO_FILE.is_file()
+    targets = _spec_data_targets()
+    source = PROTO_FILE.relative_to(ROOT).as_posix()
+    assert targets.get(source) == PROTO_FILE.parent.relative_to(ROOT).as_posix(), targets
+
+
+def _dist_smoke() -> Any:
+    """tools/dist_smoke.py (a script, not a package) as a module."""
+    path = ROOT / "tools" / "dist_smoke.py"
+    spec = importlib.util.spec_from_file_location("dist_smoke", path)
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    sys.modules.setdefault("dist_smoke", module)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_the_bundle_smokes_gateway_step_passes_with_the_venvs_gateway(tmp_path: Path) -> None:
+    """The smoke's gateway step (the bundle's is run by `.ci/run`), here with the venv's console
+    script: `--version`, then a one-controller cell of a real simulator to a Mosquitto the step
+    starts; an independent subscriber decodes NBIRTH and the DBIRTH with the simulator's pose;
+    SIGTERM: exit 0 and the NDEATH with the NBIRTH's bdSeq."""
+    from app.sim.config import SimConfig
+    from app.sim.server import SimController
+
+    smoke = _dist_smoke()
+    exe = Path(sys.executable).parent / f"teachpad-gateway{smoke.EXE_SUFFIX}"
+    assert exe.is_file(), f"{exe}: the venv's console script (make .venv/.installed-stamp)"
+    sim = SimController(SimConfig(host="127.0.0.1", port=0))
+    sim.start()
+    try:
+        steps: list[dict[str, Any]] = []
+        facts = smoke.smoke_gateway(exe, sim.port, dict(os.environ), tmp_path, steps)
+        x = sim.state().pose[0]
+    finally:
+        sim.stop()
+    assert facts["pose_x"] == pytest.approx(x, abs=0.01)
+    if sys.platform != "win32":  # terminate() there is TerminateProcess: no clean stop, no NDEATH
+        assert facts["exit"] == 0 and facts["ndeath_bdSeq"] == facts["bdSeq"]
+    assert [s["step"] for s in steps] == ["teachpad-gateway --version", "teachpad-gateway -> mosquitto"]
 
 
 def test_the_bench_says_why_when_the_bundle_is_not_built(tmp_path: Path) -> None:
