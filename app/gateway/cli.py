@@ -183,7 +183,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     reload = threading.Event()
     for sig in (signal.SIGINT, signal.SIGTERM):
         signal.signal(sig, lambda *_: done.set())
-    signal.signal(signal.SIGHUP, lambda *_: reload.set())
+    hangup = getattr(signal, "SIGHUP", None)  # none on Windows: the cell file is read at start only
+    if hangup is not None:
+        signal.signal(hangup, lambda *_: reload.set())
     edge.start()
     print(
         f"{PROG}: {len(cell.controllers)} controller(s) of cell {cell.name!r} -> {broker.host}:{broker.port} "
