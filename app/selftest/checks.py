@@ -148,12 +148,13 @@ def _setting_fix(name: str, value: str) -> tuple[str, str, tuple[str, str]]:
     return (f'set the register profile\'s {name} to "{value}"', "setting", (name, value))
 
 
-def _refused(check: str, what: str, code: int) -> CheckLine:
+def _refused(check: str, block: tuple[int, int], code: int) -> CheckLine:
+    what = f"{block[0]}..{block[0] + block[1] - 1}"
     return CheckLine(
         check,
         Verdict.UNCHECKED,
         "refused",
-        f"the controller refused the read of {what} (Modbus exception {code})",
+        f"the controller refused the read of registers {what} (Modbus exception {code})",
         {"what": what, "exception": code},
     )
 
@@ -173,13 +174,13 @@ def check_register_map(
     lines: list[CheckLine] = []
     if pose_regs is None:
         code = read.refusal(*POSE_BLOCK) or 0
-        lines.append(_refused("pose", "the pose block (412..511)", code))
+        lines.append(_refused("pose", POSE_BLOCK, code))
     else:
         lines.append(check_pose(pose_regs, word_order))
         lines.append(check_model(pose_regs, word_order, model))
     if status_regs is None:
         code = read.refusal(*STATUS_BLOCK) or 0
-        lines.append(_refused("status", "table 2 (560..583)", code))
+        lines.append(_refused("status", STATUS_BLOCK, code))
     else:
         lines += check_status(status_regs, word_order, datetime_layout, now)
     if pose_regs is not None:
@@ -467,7 +468,7 @@ def check_clock(regs: Sequence[int], layout: DateTimeLayout, now: dt.datetime) -
     }
     if clock.value is not None:
         off = (clock.value - now).total_seconds()
-        args.update(clock=_clock_text(clock.value), apart=_apart(off))
+        args.update(clock=_clock_text(clock.value), apart=_apart(off), seconds=round(off))
         if abs(off) <= CLOCK_TOLERANCE:
             text = f"the controller's clock reads {args['clock']}, the PC's {args['pc']}"
             return CheckLine("clock", Verdict.MATCH, "clock-ok", text, args)
