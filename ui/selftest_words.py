@@ -8,18 +8,18 @@ from collections.abc import Mapping
 
 from PySide6.QtCore import QCoreApplication
 
+from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
 from app.protocol.enums import ALARM_BITS, ALARM_TEXT
-from app.protocol.codec import WordOrder
 from app.selftest.checks import CheckLine, SelfTestReport, Verdict
-from ui.messages_word_order import order_name
+from ui.messages_word_order import order_name, value_text
 
 __all__ = ["check_name", "fix_text", "found_text", "summary_text", "verdict_text"]
 
 _CONTEXT = "SelfTestWords"
 
 
-def QT_TRANSLATE_NOOP(context: str, text: str) -> str:  # noqa: N802 - Qt's name, for the extractor
+def QT_TRANSLATE_NOOP(context: str, text: str) -> str:
     return text
 
 
@@ -49,7 +49,9 @@ _FOUND = {
         "SelfTestWords", "The controller refused the read of registers {what} (Modbus exception {exception})."
     ),
     "pose-zero": QT_TRANSLATE_NOOP("SelfTestWords", "X Y Z A B C are all 0: nothing to judge."),
-    "pose-ok": QT_TRANSLATE_NOOP("SelfTestWords", "Read {order}, the pose is one a robot can stand at: {pose}."),
+    "pose-ok": QT_TRANSLATE_NOOP(
+        "SelfTestWords", "Read {order}, the pose is one a robot can stand at: {pose}."
+    ),
     "pose-swapped": QT_TRANSLATE_NOOP(
         "SelfTestWords", "Read {order}, the pose is {pose}; read {other}, it is {other_pose}."
     ),
@@ -63,11 +65,13 @@ _FOUND = {
         "cannot be computed from them.",
     ),
     "model-agrees": QT_TRANSLATE_NOOP(
-        "SelfTestWords", "The robot model “{model}” computes the pose from the joints within {mm} mm and {deg}°."
+        "SelfTestWords",
+        "The robot model “{model}” computes the pose from the joints within {mm} mm and {deg}°.",
     ),
     "model-word-order": QT_TRANSLATE_NOOP(
         "SelfTestWords",
-        "The robot model “{model}” does not compute the pose from the joints read {order}; read {other}, it does.",
+        "The robot model “{model}” does not compute the pose from the joints read {order}; "
+        "read {other}, it does.",
     ),
     "model-unreadable": QT_TRANSLATE_NOOP(
         "SelfTestWords", "The joints or the pose are not finite numbers, read either way."
@@ -94,7 +98,9 @@ _FOUND = {
     "clock-layout": QT_TRANSLATE_NOOP(
         "SelfTestWords", "The date/time words ({raw}) read as {other} are this PC's time ({other_clock})."
     ),
-    "clock-invalid": QT_TRANSLATE_NOOP("SelfTestWords", "The date/time words ({raw}) are no date in either layout."),
+    "clock-invalid": QT_TRANSLATE_NOOP(
+        "SelfTestWords", "The date/time words ({raw}) are no date in either layout."
+    ),
     "clock-ahead": QT_TRANSLATE_NOOP(
         "SelfTestWords", "The controller's clock reads {clock}: {apart} ahead of this PC's ({pc})."
     ),
@@ -103,13 +109,16 @@ _FOUND = {
     ),
     "status-ok": QT_TRANSLATE_NOOP("SelfTestWords", "GV291 = {value} ({meaning})."),
     "status-word-order": QT_TRANSLATE_NOOP(
-        "SelfTestWords", "GV291's words ({raw}) are no status code read {order}; read {other}, they are {other_value}."
+        "SelfTestWords",
+        "GV291's words ({raw}) are no status code read {order}; read {other}, they are {other_value}.",
     ),
     "status-unknown": QT_TRANSLATE_NOOP(
         "SelfTestWords", "GV291's words ({raw}) are none of the documented status codes."
     ),
     "in-range": QT_TRANSLATE_NOOP("SelfTestWords", "Register {register} = {value} (within {low}–{high})."),
-    "out-of-range": QT_TRANSLATE_NOOP("SelfTestWords", "Register {register} = {value}: outside {low}–{high}."),
+    "out-of-range": QT_TRANSLATE_NOOP(
+        "SelfTestWords", "Register {register} = {value}: outside {low}–{high}."
+    ),
 }
 _FIXES = {
     "setting": QT_TRANSLATE_NOOP(
@@ -125,7 +134,8 @@ _FIXES = {
         "or tell the TeachPad team.",
     ),
     "robot-model": QT_TRANSLATE_NOOP(
-        "SelfTestWords", "Load the robot model of this arm (3D view → Robot model…), or check the joint registers."
+        "SelfTestWords",
+        "Load the robot model of this arm (3D view → Robot model…), or check the joint registers.",
     ),
     "clock": QT_TRANSLATE_NOOP(
         "SelfTestWords", "Set the controller's clock (or this PC's): not a register profile setting."
@@ -153,7 +163,8 @@ _HOURS = QT_TRANSLATE_NOOP("SelfTestWords", "{n} h")
 _SECONDS = QT_TRANSLATE_NOOP("SelfTestWords", "{n} s")
 _NONE = QT_TRANSLATE_NOOP("SelfTestWords", "none")
 _PASSED = QT_TRANSLATE_NOOP(
-    "SelfTestWords", "The register map matches the register profile: {match} checks matched, {unchecked} not checked."
+    "SelfTestWords",
+    "The register map matches the register profile: {match} checks matched, {unchecked} not checked.",
 )
 _FAILED = QT_TRANSLATE_NOOP(
     "SelfTestWords",
@@ -203,6 +214,11 @@ def _args(line: CheckLine) -> dict[str, object]:
         value = args.get(key)
         if isinstance(value, str):
             args[key] = _value_name("word_order" if line.check != "clock" else "datetime_layout", value)
+    for key, prefix in (("pose", "p"), ("other_pose", "o")):  # numbers without letters (1.2×10⁻⁴¹)
+        if f"{prefix}0" in args:
+            args[key] = " ".join(
+                f"{name} = {value_text(float(str(args[f'{prefix}{i}'])))}" for i, name in enumerate("XYZABC")
+            )
     if "meaning" in args:
         args["meaning"] = _protocol(args["meaning"])
     if "reading" in args:

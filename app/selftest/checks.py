@@ -37,7 +37,7 @@ from typing import TYPE_CHECKING, Final
 
 from app.geometry import abc_to_matrix, rot_x, rot_y, rot_z
 from app.link.register_reads import RegisterBlocks
-from app.protocol import registers as R
+from app.protocol import registers
 from app.protocol.codec import WordOrder, decode_floats, registers_to_float
 from app.protocol.datetime_regs import DateTimeLayout, decode_clock
 from app.protocol.enums import (
@@ -73,8 +73,8 @@ __all__ = [
 ]
 
 #: The blocks the self-test reads (start, count), all 0x03: those the link polls.
-POSE_BLOCK: Final = (R.POSE_BLOCK_START, R.POSE_BLOCK_COUNT)  # 412..511 (446..451 inside)
-STATUS_BLOCK: Final = (R.STATUS_BLOCK_START, R.STATUS_BLOCK_COUNT)  # 560..583
+POSE_BLOCK: Final = (registers.POSE_BLOCK_START, registers.POSE_BLOCK_COUNT)  # 412..511 (446..451 inside)
+STATUS_BLOCK: Final = (registers.STATUS_BLOCK_START, registers.STATUS_BLOCK_COUNT)  # 560..583
 SELFTEST_BLOCKS: Final = (POSE_BLOCK, STATUS_BLOCK)
 
 #: The controller's clock and the PC's may differ this much (s) and still agree: the clock
@@ -184,7 +184,7 @@ def check_register_map(
     else:
         lines += check_status(status_regs, word_order, datetime_layout, now)
     if pose_regs is not None:
-        program = R.REG_PROGRAM_ID - R.POSE_BLOCK_START
+        program = registers.REG_PROGRAM_ID - registers.POSE_BLOCK_START
         lines += check_program(pose_regs[program : program + 6])
     return SelfTestReport(tuple(lines), word_order, datetime_layout, read.read_at)
 
@@ -193,7 +193,7 @@ def check_register_map(
 
 
 def _gvs(regs: Sequence[int], gv: int, count: int, order: WordOrder) -> list[float]:
-    start = R.gv_reg(gv) - R.POSE_BLOCK_START
+    start = registers.gv_reg(gv) - registers.POSE_BLOCK_START
     return decode_floats(regs[start : start + 2 * count], order)
 
 
@@ -203,12 +203,15 @@ def _pose_text(values: Sequence[float]) -> str:
 
 def check_pose(regs: Sequence[int], order: WordOrder) -> CheckLine:
     """X Y Z A B C and the external axes: a pose in the profile's order, or only in the other."""
-    values = _gvs(regs, R.GV_POSE, 6, order) + _gvs(regs, R.GV_EXT_AXES, R.NUM_EXTERNAL_AXES, order)
-    start = R.gv_reg(R.GV_POSE) - R.POSE_BLOCK_START
+    values = _gvs(regs, registers.GV_POSE, 6, order) + _gvs(
+        regs, registers.GV_EXT_AXES, registers.NUM_EXTERNAL_AXES, order
+    )
+    start = registers.gv_reg(registers.GV_POSE) - registers.POSE_BLOCK_START
     if not any(regs[start : start + 12]):
         return CheckLine("pose", Verdict.UNCHECKED, "pose-zero", "X Y Z A B C are all 0: nothing to judge")
     verdict = judge_values(values, order)
     args: dict[str, str | int | float] = {"order": order.value, "pose": _pose_text(verdict.read)}
+    args.update({f"p{i}": v for i, v in enumerate(verdict.read[:6])})  # the GUI writes them its way
     if is_pose(verdict.read):
         return CheckLine(
             "pose", Verdict.MATCH, "pose-ok", f"read {order.value}, {args['pose']} is a pose", args
@@ -216,6 +219,7 @@ def check_pose(regs: Sequence[int], order: WordOrder) -> CheckLine:
     if verdict.swapped:
         other = other_order(order).value
         args.update(other=other, other_pose=_pose_text(verdict.other))
+        args.update({f"o{i}": v for i, v in enumerate(verdict.other[:6])})
         fix, fix_code, setting = _setting_fix("word_order", other)
         text = f"read {order.value} the pose is {args['pose']}; read {other} it is {args['other_pose']}"
         return CheckLine("pose", Verdict.MISMATCH, "pose-swapped", text, args, fix, fix_code, setting)
@@ -285,10 +289,10 @@ def _finite(values: Sequence[float]) -> bool:
 
 def check_model(regs: Sequence[int], order: WordOrder, model: ArmModel | None) -> CheckLine:
     """The model's forward kinematics of the joints against the pose (see the module docstring)."""
-    start = R.gv_reg(R.GV_JOINTS) - R.POSE_BLOCK_START
+    start = registers.gv_reg(registers.GV_JOINTS) - registers.POSE_BLOCK_START
     if model is None:
         return CheckLine("model", Verdict.UNCHECKED, "no-model", "no robot model to compute the pose with")
-    if not any(regs[start : start + 2 * R.NUM_ROBOT_AXES]):
+    if not any(regs[start : start + 2 * registers.NUM_ROBOT_AXES]):
         return CheckLine(
             "model",
             Verdict.UNCHECKED,
@@ -296,8 +300,8 @@ def check_model(regs: Sequence[int], order: WordOrder, model: ArmModel | None) -
             "the controller publishes no joint angles in GV250..GV255 (a project extension): "
             "the pose cannot be computed from the joints",
         )
-    joints = _gvs(regs, R.GV_JOINTS, R.NUM_ROBOT_AXES, order)
-    pose = _gvs(regs, R.GV_POSE, 6, order)
+    joints = _gvs(regs, registers.GV_JOINTS, registers.NUM_ROBOT_AXES, order)
+    pose = _gvs(regs, registers.GV_POSE, 6, order)
     name = model.profile.name
     agreement = compare_model(model, joints, pose) if _finite(joints + pose) else None
     if agreement is not None and agreement.agrees:
@@ -318,7 +322,7 @@ def _model_disagrees(regs: Sequence[int], order: WordOrder, model: ArmModel, unr
     """Which other reading of the same registers the model agrees with: the likely fix."""
     name = model.profile.name
     other = other_order(order)
-    joints_o, pose_o = _gvs(regs, R.GV_JOINTS, 6, other), _gvs(regs, R.GV_POSE, 6, other)
+    joints_o, pose_o = _gvs(regs, registers.GV_JOINTS, 6, other), _gvs(regs, registers.GV_POSE, 6, other)
     if _finite(joints_o + pose_o):
         agreement = compare_model(model, joints_o, pose_o)
         if agreement is not None and agreement.agrees:
@@ -331,7 +335,7 @@ def _model_disagrees(regs: Sequence[int], order: WordOrder, model: ArmModel, unr
             return CheckLine(
                 "model", Verdict.MISMATCH, "model-word-order", text, args, fix, fix_code, setting
             )
-    joints, pose = _gvs(regs, R.GV_JOINTS, 6, order), _gvs(regs, R.GV_POSE, 6, order)
+    joints, pose = _gvs(regs, registers.GV_JOINTS, 6, order), _gvs(regs, registers.GV_POSE, 6, order)
     if unreadable or not _finite(joints + pose):
         return CheckLine(
             "model",
@@ -385,13 +389,15 @@ def check_status(
     regs: Sequence[int], order: WordOrder, layout: DateTimeLayout, now: dt.datetime
 ) -> list[CheckLine]:
     """Mode, program state, alarms, clock and GV291 from registers 560..583."""
-    base = R.STATUS_BLOCK_START
-    clock = R.gv_reg(R.GV_DATE) - base
-    status = R.gv_reg(R.GV_COMMAND_STATUS) - base
+    base = registers.STATUS_BLOCK_START
+    clock = registers.gv_reg(registers.GV_DATE) - base
+    status = registers.gv_reg(registers.GV_COMMAND_STATUS) - base
     return [
-        _in_table("mode", R.REG_CONTROLLER_MODE, regs[R.REG_CONTROLLER_MODE - base], _MODES),
-        _in_table("program state", R.REG_PROGRAM_STATE, regs[R.REG_PROGRAM_STATE - base], _STATES),
-        check_alarms(regs[R.REG_ALARMS - base]),
+        _in_table("mode", registers.REG_CONTROLLER_MODE, regs[registers.REG_CONTROLLER_MODE - base], _MODES),
+        _in_table(
+            "program state", registers.REG_PROGRAM_STATE, regs[registers.REG_PROGRAM_STATE - base], _STATES
+        ),
+        check_alarms(regs[registers.REG_ALARMS - base]),
         check_clock(regs[clock : clock + 4], layout, now),
         check_command_status(regs[status : status + 2], order),
     ]
@@ -426,7 +432,7 @@ def check_alarms(value: int) -> CheckLine:
     """Register 562: only the five documented bits (an alarm that is on still matches the map)."""
     unknown = value & ~ALARM_MASK & 0xFFFF
     names = ", ".join(alarm_names(value & ALARM_MASK)) or "none"
-    args: dict[str, str | int | float] = {"register": R.REG_ALARMS, "value": value, "alarms": names}
+    args: dict[str, str | int | float] = {"register": registers.REG_ALARMS, "value": value, "alarms": names}
     if not unknown:
         return CheckLine(
             "alarms", Verdict.MATCH, "alarms-ok", f"register 562 = {value} (alarms: {names})", args
@@ -477,7 +483,10 @@ def check_clock(regs: Sequence[int], layout: DateTimeLayout, now: dt.datetime) -
     if swapped is not None and abs((swapped - now).total_seconds()) <= CLOCK_TOLERANCE:
         args.update(other=other.value, other_clock=_clock_text(swapped))
         fix, fix_code, setting = _setting_fix("datetime_layout", other.value)
-        text = f"the date/time words ({clock.raw_hex}) read {other.value} are the PC's time {args['other_clock']}"
+        text = (
+            f"the date/time words ({clock.raw_hex}) read {other.value} are the PC's time "
+            f"{args['other_clock']}"
+        )
         return CheckLine("clock", Verdict.MISMATCH, "clock-layout", text, args, fix, fix_code, setting)
     if clock.value is None:
         text = f"the date/time words ({clock.raw_hex}) are no date read {layout.value} or {other.value}"
@@ -515,7 +524,10 @@ def check_command_status(words: Sequence[int], order: WordOrder) -> CheckLine:
         other = other_order(order).value
         args.update(other=other, other_value=swapped)
         fix, fix_code, setting = _setting_fix("word_order", other)
-        text = f"GV291's words ({args['raw']}) are no status code read {order.value}; read {other} they are {swapped}"
+        text = (
+            f"GV291's words ({args['raw']}) are no status code read {order.value}; "
+            f"read {other} they are {swapped}"
+        )
         return CheckLine(
             "command status", Verdict.MISMATCH, "status-word-order", text, args, fix, fix_code, setting
         )
@@ -529,14 +541,19 @@ def check_command_status(words: Sequence[int], order: WordOrder) -> CheckLine:
 
 def check_program(regs: Sequence[int]) -> list[CheckLine]:
     """Program motion mode (447) within its table, speed ratio (449) within 0..100."""
-    base = R.REG_PROGRAM_ID
+    base = registers.REG_PROGRAM_ID
     lines = [
-        _in_table("program motion mode", R.REG_PROGRAM_MODE, regs[R.REG_PROGRAM_MODE - base], _MOTION_MODES)
+        _in_table(
+            "program motion mode",
+            registers.REG_PROGRAM_MODE,
+            regs[registers.REG_PROGRAM_MODE - base],
+            _MOTION_MODES,
+        )
     ]
-    ratio = regs[R.REG_PROGRAM_SPEED - base]
+    ratio = regs[registers.REG_PROGRAM_SPEED - base]
     lo, hi = _SPEED_RATIO_RANGE
     args: dict[str, str | int | float] = {
-        "register": R.REG_PROGRAM_SPEED,
+        "register": registers.REG_PROGRAM_SPEED,
         "value": ratio,
         "low": lo,
         "high": hi,

@@ -274,13 +274,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.controllers is not None and args.serial:
         parser.error("--controllers serves TCP ports; it cannot be used with --serial")
-    if args.replay is not None and (args.serial or args.controllers is not None):
-        parser.error("--replay serves one TCP port; it cannot be used with --serial or --controllers")
-    _configure_logging(args.verbose)
     if args.replay is not None:
-        from app.sim.replay_cli import run_replay
-
-        return run_replay(args, _stop_on_signals, _say)
+        return _replay(parser, args)
+    _configure_logging(args.verbose)
     config = _sim_config(args)
     fleet = _started_fleet(args, config)
     if fleet is None:
@@ -308,6 +304,16 @@ def main(argv: Sequence[str] | None = None) -> int:
             signal.signal(sig, handler)  # type: ignore[arg-type]
     _say("teachpad-sim stopped")
     return 0
+
+
+def _replay(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
+    """``--replay CAPTURE``: a traffic capture answers instead of the simulated robot."""
+    if args.serial or args.controllers is not None:
+        parser.error("--replay serves one TCP port; it cannot be used with --serial or --controllers")
+    _configure_logging(args.verbose)
+    from app.sim.replay_cli import run_replay
+
+    return run_replay(args, _stop_on_signals, _say)
 
 
 def _started_fleet(args: argparse.Namespace, config: SimConfig) -> SimFleet | None:

@@ -146,7 +146,9 @@ def parse_capture_text(text: str, source: str = "the capture") -> list[Frame]:
         if direction not in ("tx", "rx"):
             raise ReplayError(f"{where}: the direction must be Tx or Rx, got {row[1][:10]!r}")
         if "…" in row[2]:
-            raise ReplayError(f"{where}: the frame is cut short (…): export the capture, not a copy of the table")
+            raise ReplayError(
+                f"{where}: the frame is cut short (…): export the capture, not a copy of the table"
+            )
         frames.append(Frame(number, "tx" if direction == "tx" else "rx", _hex_bytes(row[2], where), row[0]))
     return frames
 
@@ -158,7 +160,9 @@ def _capture_text(path: Path) -> str:
         if zipfile.is_zipfile(path):
             with zipfile.ZipFile(path) as bundle:
                 if "traffic.txt" not in bundle.namelist():
-                    raise ReplayError(f"{path.name}: a zip without traffic.txt (no Modbus traffic in this bundle)")
+                    raise ReplayError(
+                        f"{path.name}: a zip without traffic.txt (no Modbus traffic in this bundle)"
+                    )
                 return bundle.read("traffic.txt").decode("utf-8-sig")
         return path.read_bytes().decode("utf-8-sig")
     except OSError as exc:
@@ -263,14 +267,16 @@ class ReplayBook:
 
     def _next(self, queue: _Queue | None, unit: int, pdu: bytes) -> Exchange | None:
         if queue is None:
-            return self._unmatched(unit, pdu, "not in the capture")
+            self._unmatched(unit, pdu, "not in the capture")
+            return None
         if queue.answers:
             queue.last = queue.answers.popleft()
             return queue.last
         if queue.last is not None and pdu[:1] and pdu[0] in _READS:
             self.repeated += 1
             return queue.last
-        return self._unmatched(unit, pdu, "asked more often than the capture holds")
+        self._unmatched(unit, pdu, "asked more often than the capture holds")
+        return None
 
     def _unmatched(self, unit: int, pdu: bytes, why: str) -> None:
         item = Unmatched(unit, pdu, why)
@@ -304,7 +310,7 @@ class ReplayServer:
         self.host = host
         self._port = port
         self._loop: asyncio.AbstractEventLoop | None = None
-        self._server: asyncio.AbstractServer | None = None
+        self._server: asyncio.Server | None = None
         self._thread: threading.Thread | None = None
         self._writers: set[asyncio.StreamWriter] = set()
         self.requests = 0
@@ -326,7 +332,9 @@ class ReplayServer:
         def run() -> None:
             asyncio.set_event_loop(loop)
             try:
-                self._server = loop.run_until_complete(asyncio.start_server(self._serve, self.host, self._port))
+                self._server = loop.run_until_complete(
+                    asyncio.start_server(self._serve, self.host, self._port)
+                )
             except OSError as exc:
                 errors.append(exc)
                 ready.set()

@@ -148,7 +148,7 @@ def test_units_and_abc_conventions_are_named() -> None:
     import math
 
     from app.geometry import matrix_to_abc, rot_y, rot_z
-    from app.protocol import registers as R
+    from app.protocol import registers
     from app.protocol.codec import encode_floats
 
     model = ArmModel(default_profile())
@@ -159,9 +159,9 @@ def test_units_and_abc_conventions_are_named() -> None:
     def read_of(pose: list[float]) -> RegisterBlocks:
         values = dict(enumerate([0] * 1024))
         for i, v in enumerate(encode_floats(pose, WordOrder.LOW_FIRST)):
-            values[R.gv_reg(R.GV_POSE) + i] = v
+            values[registers.gv_reg(registers.GV_POSE) + i] = v
         for i, v in enumerate(encode_floats(joints, WordOrder.LOW_FIRST)):
-            values[R.gv_reg(R.GV_JOINTS) + i] = v
+            values[registers.gv_reg(registers.GV_JOINTS) + i] = v
         now = dt.datetime.now()
         return RegisterBlocks(SELFTEST_BLOCKS, values, {}, now.timestamp())
 

@@ -28,7 +28,11 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 )
 from tests.ui.test_messages import assert_chinese
 
-pytestmark = [pytest.mark.timeout(120), pytest.mark.qt_log_ignore(*QT_LOG_IGNORE)]
+# the offscreen platform cannot raise a window (the dialog is raised when asked for again)
+pytestmark = [
+    pytest.mark.timeout(120),
+    pytest.mark.qt_log_ignore(*QT_LOG_IGNORE, "This plugin does not support raise"),
+]
 
 SHOTS = Path(__file__).resolve().parents[2] / "docs" / "screenshots"
 CANARY_REGISTERS = {198}  # the restart canary GV99, written by every connect (not by the self-test)
@@ -105,7 +109,9 @@ def test_the_dialog_shows_each_line_in_both_languages(qtbot: Any, sim_factory: A
     table = dialog.table
     report = window.register_map_check.report
     assert table.rowCount() == len(report.lines)
-    rows = {table.item(r, 0).text(): [table.item(r, c).text() for c in range(4)] for r in range(table.rowCount())}
+    rows = {
+        table.item(r, 0).text(): [table.item(r, c).text() for c in range(4)] for r in range(table.rowCount())
+    }
     clock = rows["Date and time (576–579)"]
     assert clock[1] == "does not match" and "365 days behind" in clock[2] and "clock" in clock[3]
     pose = rows["Pose X Y Z A B C (word order)"]
@@ -116,12 +122,13 @@ def test_the_dialog_shows_each_line_in_both_languages(qtbot: Any, sim_factory: A
         _shot(window, dialog, SHOTS / "selftest_en_1280x800.png")
     window.set_language("zh_CN")
     rows_zh = [[table.item(r, c).text() for c in range(4)] for r in range(table.rowCount())]
+    model = window.view3d.robot.profile.name  # a name, as the profile file gives it
     for row in rows_zh:
         for text in row:
             if text:
-                assert_chinese(text.replace("ABCD", "").replace("CDAB", ""))
+                assert_chinese(text.replace("ABCD", "").replace("CDAB", "").replace(model, ""))
     assert_chinese(dialog.summary_label.text())
-    assert_chinese(window.register_map_ui.action.text())
+    assert_chinese(window.register_map_ui.action.text().replace("(&R)", ""))  # the accelerator key
     if os.environ.get("TEACHPAD_SCREENSHOTS", "1") != "0":
         _shot(window, dialog, SHOTS / "selftest_zh_1280x800.png")
     dialog.close()

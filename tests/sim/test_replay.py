@@ -179,7 +179,9 @@ def test_a_fresh_teachpad_link_connects_to_the_replay_and_sees_the_captured_pose
     try:
         with ReplayServer(book) as server:
             with qtbot.waitSignal(link.state.poseChanged, timeout=SIGNAL_TIMEOUT_MS) as pose:
-                link.connect_to(ConnectionSettings(host="127.0.0.1", port=server.port, timeout=1.0, poll_timeout=1.0))
+                link.connect_to(
+                    ConnectionSettings(host="127.0.0.1", port=server.port, timeout=1.0, poll_timeout=1.0)
+                )
             assert pose.args[0].xyzabc == expected.xyzabc
             with qtbot.waitSignal(link.connectionChanged, check_params_cb=is_state(LinkState.DISCONNECTED)):
                 link.disconnect()
@@ -191,7 +193,7 @@ def test_a_fresh_teachpad_link_connects_to_the_replay_and_sees_the_captured_pose
 def test_bad_captures_are_said_in_words(tmp_path: Path) -> None:
     bad = tmp_path / "bad.csv"
     bad.write_text("time,direction,bytes,meaning\n12:00:00.000,Sideways,00 01,x\n", encoding="utf-8")
-    with pytest.raises(ReplayError, match="line 2: the direction must be Tx or Rx"):
+    with pytest.raises(ReplayError, match=r"line 2: the direction must be Tx or Rx"):
         read_capture(bad)
     with pytest.raises(ReplayError, match="cannot read the capture"):
         read_capture(tmp_path / "missing.csv")
@@ -200,7 +202,7 @@ def test_bad_captures_are_said_in_words(tmp_path: Path) -> None:
     empty_zip = tmp_path / "bundle.zip"
     with zipfile.ZipFile(empty_zip, "w") as z:
         z.writestr("manifest.json", "{}")
-    with pytest.raises(ReplayError, match="without traffic.txt"):
+    with pytest.raises(ReplayError, match=r"without traffic\.txt"):
         read_capture(empty_zip)
 
 

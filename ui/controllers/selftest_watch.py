@@ -122,7 +122,7 @@ class RegisterMapCheck(QObject):
         self.failed.emit(text)
 
 
-class _Installed(QObject):
+class RegisterMapMenu(QObject):
     """The Help menu's action, the dialog, and what a report with a mismatch says."""
 
     def __init__(self, window: Any, check: RegisterMapCheck) -> None:
@@ -139,7 +139,7 @@ class _Installed(QObject):
         window.installEventFilter(self)
         self.retranslate()
 
-    def eventFilter(self, watched: QObject, event: QEvent) -> bool:  # noqa: N802 - Qt's name
+    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
         if watched is self.window and event.type() == QEvent.Type.LanguageChange:
             self.retranslate()
         return False
@@ -147,7 +147,10 @@ class _Installed(QObject):
     def retranslate(self) -> None:
         self.action.setText(self.tr("Check the controller's &register map…"))
         self.action.setToolTip(
-            self.tr("Read the documented registers (nothing is written) and check them against the register profile")
+            self.tr(
+                "Read the documented registers (nothing is written) and check them against the "
+                "register profile"
+            )
         )
 
     @Slot()
@@ -177,8 +180,10 @@ class _Installed(QObject):
 
         self.window.event_log.add_event("warning", lambda: self.tr("register map"), details)
         self.window.status_bar.show_message(
-            self.tr("The controller's register map does not match the register profile: Help → Check the "
-                    "controller's register map…")
+            self.tr(
+                "The controller's register map does not match the register profile: Help → Check the "
+                "controller's register map…"
+            )
         )
 
 
@@ -191,5 +196,5 @@ def install_register_map_check(window: Any) -> RegisterMapCheck:
 
     check = RegisterMapCheck(window.link, model, window)
     check.setObjectName("RegisterMapCheck")
-    window.register_map_ui = _Installed(window, check)
+    window.register_map_ui = RegisterMapMenu(window, check)
     return check

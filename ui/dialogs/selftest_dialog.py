@@ -9,8 +9,8 @@ report made after every connect shows here too.
 
 from __future__ import annotations
 
-from PySide6.QtCore import QEvent, Qt, Slot
-from PySide6.QtGui import QBrush, QColor
+from PySide6.QtCore import QEvent, Qt, QTimer, Slot
+from PySide6.QtGui import QBrush, QColor, QShowEvent
 from PySide6.QtWidgets import (
     QAbstractItemView,
     QDialog,
@@ -57,6 +57,12 @@ class SelfTestDialog(QDialog):
         header.setSectionResizeMode(1, QHeaderView.ResizeMode.ResizeToContents)
         header.setSectionResizeMode(2, QHeaderView.ResizeMode.Stretch)
         header.setSectionResizeMode(3, QHeaderView.ResizeMode.Stretch)
+        # the wrapped texts' heights follow the columns' widths (known once shown, or resized)
+        self._fit_rows = QTimer(self)
+        self._fit_rows.setSingleShot(True)
+        self._fit_rows.setInterval(0)
+        self._fit_rows.timeout.connect(self.table.resizeRowsToContents)
+        header.sectionResized.connect(lambda *_: self._fit_rows.start())
         self.again_button = QPushButton(self)
         self.again_button.setObjectName("SelfTestAgain")
         self.again_button.clicked.connect(self._again)
@@ -74,10 +80,14 @@ class SelfTestDialog(QDialog):
         self.resize(1000, 520)
         self.retranslate()
 
-    def changeEvent(self, event: QEvent) -> None:  # noqa: N802 - Qt's name
+    def changeEvent(self, event: QEvent) -> None:
         if event.type() == QEvent.Type.LanguageChange:
             self.retranslate()
         super().changeEvent(event)
+
+    def showEvent(self, event: QShowEvent) -> None:
+        super().showEvent(event)
+        self.table.resizeRowsToContents()
 
     def retranslate(self) -> None:
         self.setWindowTitle(self.tr("The controller's register map"))
@@ -132,7 +142,12 @@ class SelfTestDialog(QDialog):
             verdict = QTableWidgetItem(verdict_text(line.verdict))
             verdict.setForeground(QBrush(QColor(_VERDICT_COLOR[line.verdict])))
             found = found_text(line)
-            cells = (QTableWidgetItem(check_name(line)), verdict, QTableWidgetItem(found), QTableWidgetItem(fix_text(line)))
+            cells = (
+                QTableWidgetItem(check_name(line)),
+                verdict,
+                QTableWidgetItem(found),
+                QTableWidgetItem(fix_text(line)),
+            )
             for column, item in enumerate(cells):
                 item.setToolTip(line.line if column < 2 else item.text())
                 item.setTextAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignVCenter)
