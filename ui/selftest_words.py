@@ -11,7 +11,8 @@ from PySide6.QtCore import QCoreApplication
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
 from app.protocol.enums import ALARM_BITS, ALARM_TEXT
-from app.selftest.checks import CheckLine, SelfTestReport, Verdict
+from app.selftest.checks import CheckLine, CheckVerdict, SelfTestReport
+from ui.joins import join_names
 from ui.messages_word_order import order_name, value_text
 
 __all__ = ["check_name", "fix_text", "found_text", "summary_text", "verdict_text"]
@@ -40,9 +41,9 @@ _CHECKS = {
     "status": QT_TRANSLATE_NOOP("SelfTestWords", "Status registers (560–583)"),
 }
 _VERDICTS = {
-    Verdict.MATCH: QT_TRANSLATE_NOOP("SelfTestWords", "matches"),
-    Verdict.MISMATCH: QT_TRANSLATE_NOOP("SelfTestWords", "does not match"),
-    Verdict.UNCHECKED: QT_TRANSLATE_NOOP("SelfTestWords", "not checked"),
+    CheckVerdict.MATCH: QT_TRANSLATE_NOOP("SelfTestWords", "matches"),
+    CheckVerdict.MISMATCH: QT_TRANSLATE_NOOP("SelfTestWords", "does not match"),
+    CheckVerdict.UNCHECKED: QT_TRANSLATE_NOOP("SelfTestWords", "not checked"),
 }
 _FOUND = {
     "refused": QT_TRANSLATE_NOOP(
@@ -177,7 +178,7 @@ def check_name(line: CheckLine) -> str:
     return _tr(name) if name is not None else line.check
 
 
-def verdict_text(verdict: Verdict) -> str:
+def verdict_text(verdict: CheckVerdict) -> str:
     return _tr(_VERDICTS[verdict])
 
 
@@ -204,7 +205,7 @@ def _apart(seconds: float) -> str:
 
 def _alarms(value: int) -> str:
     names = [_protocol(ALARM_TEXT[bit]) for bit in ALARM_BITS if value & bit]
-    return ", ".join(names) or _tr(_NONE)
+    return join_names(names) or _tr(_NONE)
 
 
 def _args(line: CheckLine) -> dict[str, object]:
@@ -264,7 +265,7 @@ def fix_text(line: CheckLine) -> str:
 
 
 def summary_text(report: SelfTestReport) -> str:
-    counts = {v: sum(1 for line in report.lines if line.verdict is v) for v in Verdict}
+    counts = {v: sum(1 for line in report.lines if line.verdict is v) for v in CheckVerdict}
     if report.passed:
-        return _tr(_PASSED).format(match=counts[Verdict.MATCH], unchecked=counts[Verdict.UNCHECKED])
-    return _tr(_FAILED).format(mismatch=counts[Verdict.MISMATCH], total=len(report.lines))
+        return _tr(_PASSED).format(match=counts[CheckVerdict.MATCH], unchecked=counts[CheckVerdict.UNCHECKED])
+    return _tr(_FAILED).format(mismatch=counts[CheckVerdict.MISMATCH], total=len(report.lines))

@@ -21,7 +21,7 @@ mode, program state, alarms, clock, GV291).
 * **mode**, **program state**, **alarms**, **program motion mode**, **speed ratio** -- within
   their tables; **command status** (GV291) one of the documented codes, in either encoding.
 
-Each line has a verdict (:class:`Verdict`): MATCH, MISMATCH (with the likely fix) or UNCHECKED
+Each line has a verdict (:class:`CheckVerdict`): MATCH, MISMATCH (with the likely fix) or UNCHECKED
 (the controller refused the read, publishes nothing there). ``code`` and ``args`` let the GUI say
 the line in the operator's language; ``text`` and ``fix`` are the English (teachpad-cli, logs).
 """
@@ -67,8 +67,8 @@ __all__ = [
     "CLOCK_TOLERANCE",
     "SELFTEST_BLOCKS",
     "CheckLine",
+    "CheckVerdict",
     "SelfTestReport",
-    "Verdict",
     "check_register_map",
 ]
 
@@ -84,7 +84,7 @@ CLOCK_TOLERANCE: Final = 120.0
 _SPEED_RATIO_RANGE: Final = (0, 100)  # 449: 1..100 by the table; 0 before any program was set
 
 
-class Verdict(enum.Enum):
+class CheckVerdict(enum.Enum):
     MATCH = "match"
     MISMATCH = "mismatch"
     UNCHECKED = "not checked"
@@ -97,7 +97,7 @@ class CheckLine:
     ("" none); ``setting`` (field, value) when the fix is a register profile setting."""
 
     check: str
-    verdict: Verdict
+    verdict: CheckVerdict
     code: str
     text: str
     args: Mapping[str, str | int | float] = field(default_factory=dict)
@@ -128,7 +128,7 @@ class SelfTestReport:
 
     @property
     def mismatches(self) -> tuple[CheckLine, ...]:
-        return tuple(line for line in self.lines if line.verdict is Verdict.MISMATCH)
+        return tuple(line for line in self.lines if line.verdict is CheckVerdict.MISMATCH)
 
     @property
     def settings_to_change(self) -> dict[str, str]:
@@ -136,11 +136,11 @@ class SelfTestReport:
         return dict(line.setting for line in self.mismatches if line.setting is not None)
 
     def summary(self) -> str:
-        counts = {v: sum(1 for line in self.lines if line.verdict is v) for v in Verdict}
+        counts = {v: sum(1 for line in self.lines if line.verdict is v) for v in CheckVerdict}
         head = "the register map matches" if self.passed else "the register map does not match"
         return (
-            f"{head}: {counts[Verdict.MATCH]} matched, {counts[Verdict.MISMATCH]} did not, "
-            f"{counts[Verdict.UNCHECKED]} not checked"
+            f"{head}: {counts[CheckVerdict.MATCH]} matched, {counts[CheckVerdict.MISMATCH]} did not, "
+            f"{counts[CheckVerdict.UNCHECKED]} not checked"
         )
 
 
@@ -152,7 +152,7 @@ def _refused(check: str, block: tuple[int, int], code: int) -> CheckLine:
     what = f"{block[0]}..{block[0] + block[1] - 1}"
     return CheckLine(
         check,
-        Verdict.UNCHECKED,
+        CheckVerdict.UNCHECKED,
         "refused",
         f"the controller refused the read of registers {what} (Modbus exception {code})",
         {"what": what, "exception": code},
@@ -208,13 +208,15 @@ def check_pose(regs: Sequence[int], order: WordOrder) -> CheckLine:
     )
     start = registers.gv_reg(registers.GV_POSE) - registers.POSE_BLOCK_START
     if not any(regs[start : start + 12]):
-        return CheckLine("pose", Verdict.UNCHECKED, "pose-zero", "X Y Z A B C are all 0: nothing to judge")
+        return CheckLine(
+            "pose", CheckVerdict.UNCHECKED, "pose-zero", "X Y Z A B C are all 0: nothing to judge"
+        )
     verdict = judge_values(values, order)
     args: dict[str, str | int | float] = {"order": order.value, "pose": _pose_text(verdict.read)}
     args.update({f"p{i}": v for i, v in enumerate(verdict.read[:6])})  # the GUI writes them its way
     if is_pose(verdict.read):
         return CheckLine(
-            "pose", Verdict.MATCH, "pose-ok", f"read {order.value}, {args['pose']} is a pose", args
+            "pose", CheckVerdict.MATCH, "pose-ok", f"read {order.value}, {args['pose']} is a pose", args
         )
     if verdict.swapped:
         other = other_order(order).value
@@ -222,10 +224,10 @@ def check_pose(regs: Sequence[int], order: WordOrder) -> CheckLine:
         args.update({f"o{i}": v for i, v in enumerate(verdict.other[:6])})
         fix, fix_code, setting = _setting_fix("word_order", other)
         text = f"read {order.value} the pose is {args['pose']}; read {other} it is {args['other_pose']}"
-        return CheckLine("pose", Verdict.MISMATCH, "pose-swapped", text, args, fix, fix_code, setting)
+        return CheckLine("pose", CheckVerdict.MISMATCH, "pose-swapped", text, args, fix, fix_code, setting)
     return CheckLine(
         "pose",
-        Verdict.MISMATCH,
+        CheckVerdict.MISMATCH,
         "pose-implausible",
         f"X Y Z A B C read either way are no pose a robot stands at ({args['pose']})",
         args,
@@ -291,11 +293,13 @@ def check_model(regs: Sequence[int], order: WordOrder, model: ArmModel | None) -
     """The model's forward kinematics of the joints against the pose (see the module docstring)."""
     start = registers.gv_reg(registers.GV_JOINTS) - registers.POSE_BLOCK_START
     if model is None:
-        return CheckLine("model", Verdict.UNCHECKED, "no-model", "no robot model to compute the pose with")
+        return CheckLine(
+            "model", CheckVerdict.UNCHECKED, "no-model", "no robot model to compute the pose with"
+        )
     if not any(regs[start : start + 2 * registers.NUM_ROBOT_AXES]):
         return CheckLine(
             "model",
-            Verdict.UNCHECKED,
+            CheckVerdict.UNCHECKED,
             "no-joints",
             "the controller publishes no joint angles in GV250..GV255 (a project extension): "
             "the pose cannot be computed from the joints",
@@ -314,7 +318,7 @@ def check_model(regs: Sequence[int], order: WordOrder, model: ArmModel | None) -
             f"the robot model '{name}' computes the pose from the joints within "
             f"{args['mm']} mm and {args['deg']}°"
         )
-        return CheckLine("model", Verdict.MATCH, "model-agrees", text, args)
+        return CheckLine("model", CheckVerdict.MATCH, "model-agrees", text, args)
     return _model_disagrees(regs, order, model, agreement is None)
 
 
@@ -333,13 +337,13 @@ def _model_disagrees(regs: Sequence[int], order: WordOrder, model: ArmModel, unr
             )
             args: dict[str, str | int | float] = {"model": name, "order": order.value, "other": other.value}
             return CheckLine(
-                "model", Verdict.MISMATCH, "model-word-order", text, args, fix, fix_code, setting
+                "model", CheckVerdict.MISMATCH, "model-word-order", text, args, fix, fix_code, setting
             )
     joints, pose = _gvs(regs, registers.GV_JOINTS, 6, order), _gvs(regs, registers.GV_POSE, 6, order)
     if unreadable or not _finite(joints + pose):
         return CheckLine(
             "model",
-            Verdict.MISMATCH,
+            CheckVerdict.MISMATCH,
             "model-unreadable",
             "the joints or the pose are not finite numbers read either way",
             {"model": name},
@@ -371,7 +375,7 @@ def _model_other_units(model: ArmModel, joints: Sequence[float], pose: Sequence[
                 "to mm, degrees and fixed-axis X-Y-Z, or report it to the TeachPad team"
             )
             args: dict[str, str | int | float] = {"model": name, "reading": label}
-            return CheckLine("model", Verdict.MISMATCH, "model-units", text, args, fix, "units")
+            return CheckLine("model", CheckVerdict.MISMATCH, "model-units", text, args, fix, "units")
     found = _fit(flange, xyz, fixed)
     args = {"model": name, "mm": round(found.distance_mm, 1), "deg": round(found.angle_deg, 1)}
     text = (
@@ -379,7 +383,7 @@ def _model_other_units(model: ArmModel, joints: Sequence[float], pose: Sequence[
         "controller reports"
     )
     fix = "load the robot model of this arm (3D view, Robot model…), or check the joint registers"
-    return CheckLine("model", Verdict.MISMATCH, "model-disagrees", text, args, fix, "robot-model")
+    return CheckLine("model", CheckVerdict.MISMATCH, "model-disagrees", text, args, fix, "robot-model")
 
 
 # --- table 2 ----------------------------------------------------------------------------------
@@ -414,12 +418,12 @@ def _in_table(check: str, register: int, value: int, table: Mapping[int, str]) -
     if value in table:
         args["meaning"] = table[value]
         return CheckLine(
-            check, Verdict.MATCH, "in-table", f"register {register} = {value} ({table[value]})", args
+            check, CheckVerdict.MATCH, "in-table", f"register {register} = {value} ({table[value]})", args
         )
     args["allowed"] = allowed
     return CheckLine(
         check,
-        Verdict.MISMATCH,
+        CheckVerdict.MISMATCH,
         "out-of-table",
         f"register {register} = {value}, not one of its table's values ({allowed})",
         args,
@@ -435,12 +439,12 @@ def check_alarms(value: int) -> CheckLine:
     args: dict[str, str | int | float] = {"register": registers.REG_ALARMS, "value": value, "alarms": names}
     if not unknown:
         return CheckLine(
-            "alarms", Verdict.MATCH, "alarms-ok", f"register 562 = {value} (alarms: {names})", args
+            "alarms", CheckVerdict.MATCH, "alarms-ok", f"register 562 = {value} (alarms: {names})", args
         )
     args["bits"] = f"0x{unknown:04X}"
     return CheckLine(
         "alarms",
-        Verdict.MISMATCH,
+        CheckVerdict.MISMATCH,
         "alarms-unknown",
         f"register 562 = {value}: bits {args['bits']} are none of the five documented alarms",
         args,
@@ -465,7 +469,7 @@ def _apart(seconds: float) -> str:
 def check_clock(regs: Sequence[int], layout: DateTimeLayout, now: dt.datetime) -> CheckLine:
     """GV288/289 against the PC's clock, in the profile's layout (the other one as the fix)."""
     if not any(regs):
-        return CheckLine("clock", Verdict.UNCHECKED, "clock-zero", "the date/time registers are all 0")
+        return CheckLine("clock", CheckVerdict.UNCHECKED, "clock-zero", "the date/time registers are all 0")
     clock = decode_clock(regs, layout)
     args: dict[str, str | int | float] = {
         "layout": layout.value,
@@ -477,7 +481,7 @@ def check_clock(regs: Sequence[int], layout: DateTimeLayout, now: dt.datetime) -
         args.update(clock=_clock_text(clock.value), apart=_apart(off), seconds=round(off))
         if abs(off) <= CLOCK_TOLERANCE:
             text = f"the controller's clock reads {args['clock']}, the PC's {args['pc']}"
-            return CheckLine("clock", Verdict.MATCH, "clock-ok", text, args)
+            return CheckLine("clock", CheckVerdict.MATCH, "clock-ok", text, args)
     other = next(x for x in DateTimeLayout if x is not layout)
     swapped = decode_clock(regs, other).value
     if swapped is not None and abs((swapped - now).total_seconds()) <= CLOCK_TOLERANCE:
@@ -487,17 +491,17 @@ def check_clock(regs: Sequence[int], layout: DateTimeLayout, now: dt.datetime) -
             f"the date/time words ({clock.raw_hex}) read {other.value} are the PC's time "
             f"{args['other_clock']}"
         )
-        return CheckLine("clock", Verdict.MISMATCH, "clock-layout", text, args, fix, fix_code, setting)
+        return CheckLine("clock", CheckVerdict.MISMATCH, "clock-layout", text, args, fix, fix_code, setting)
     if clock.value is None:
         text = f"the date/time words ({clock.raw_hex}) are no date read {layout.value} or {other.value}"
         return CheckLine(
-            "clock", Verdict.MISMATCH, "clock-invalid", text, args, "set the controller's clock", "clock"
+            "clock", CheckVerdict.MISMATCH, "clock-invalid", text, args, "set the controller's clock", "clock"
         )
     ahead = "ahead of" if clock.value > now else "behind"
     args["direction"] = "ahead" if clock.value > now else "behind"
     text = f"the controller's clock reads {args['clock']}, {args['apart']} {ahead} the PC's ({args['pc']})"
     fix = "set the controller's clock (or the PC's): not a register profile setting"
-    return CheckLine("clock", Verdict.MISMATCH, "clock-off", text, args, fix, "clock")
+    return CheckLine("clock", CheckVerdict.MISMATCH, "clock-off", text, args, fix, "clock")
 
 
 _STATUS_CODES: Final = {**TEACH_STATUS_TEXT, **MOVE_STATUS_TEXT}
@@ -518,7 +522,7 @@ def check_command_status(words: Sequence[int], order: WordOrder) -> CheckLine:
     if code in _STATUS_CODES and (as_float is not None or words[1] == 0):
         args["meaning"] = MOVE_STATUS_TEXT.get(code, _STATUS_CODES[code])
         text = f"GV291 = {code} ({args['meaning']})"
-        return CheckLine("command status", Verdict.MATCH, "status-ok", text, args)
+        return CheckLine("command status", CheckVerdict.MATCH, "status-ok", text, args)
     swapped = _integral_code(words, other_order(order))
     if swapped is not None and swapped in _STATUS_CODES:
         other = other_order(order).value
@@ -529,11 +533,11 @@ def check_command_status(words: Sequence[int], order: WordOrder) -> CheckLine:
             f"read {other} they are {swapped}"
         )
         return CheckLine(
-            "command status", Verdict.MISMATCH, "status-word-order", text, args, fix, fix_code, setting
+            "command status", CheckVerdict.MISMATCH, "status-word-order", text, args, fix, fix_code, setting
         )
     text = f"GV291's words ({args['raw']}) are none of the documented status codes"
     fix = "check the unit id and that this controller has the vendor document's register map"
-    return CheckLine("command status", Verdict.MISMATCH, "status-unknown", text, args, fix, "check-map")
+    return CheckLine("command status", CheckVerdict.MISMATCH, "status-unknown", text, args, fix, "check-map")
 
 
 # --- the program registers (446..451) ---------------------------------------------------------
@@ -561,14 +565,18 @@ def check_program(regs: Sequence[int]) -> list[CheckLine]:
     if lo <= ratio <= hi:
         lines.append(
             CheckLine(
-                "speed ratio", Verdict.MATCH, "in-range", f"register 449 = {ratio} (within {lo}..{hi})", args
+                "speed ratio",
+                CheckVerdict.MATCH,
+                "in-range",
+                f"register 449 = {ratio} (within {lo}..{hi})",
+                args,
             )
         )
     else:
         lines.append(
             CheckLine(
                 "speed ratio",
-                Verdict.MISMATCH,
+                CheckVerdict.MISMATCH,
                 "out-of-range",
                 f"register 449 = {ratio}, outside {lo}..{hi}",
                 args,

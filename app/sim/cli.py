@@ -313,7 +313,7 @@ def _replay(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
     _configure_logging(args.verbose)
     from app.sim.replay_cli import run_replay
 
-    return run_replay(args, _stop_on_signals, _say)
+    return run_replay(args, _stop_on_signals, _say, _wait_for_end_of_stdin)
 
 
 def _started_fleet(args: argparse.Namespace, config: SimConfig) -> SimFleet | None:

@@ -24,7 +24,9 @@ def run_replay(
     args: argparse.Namespace,
     stop_on_signals: Callable[[threading.Event], dict[signal.Signals, object]],
     say: Callable[[str], None],
+    wait_for_end_of_stdin: Callable[[threading.Event], None],
 ) -> int:
+    """Serve ``args.replay``; the simulator's own helpers (app/sim/cli.py) are passed in."""
     try:
         exchanges = read_capture(Path(args.replay))
     except ReplayError as exc:
@@ -46,9 +48,7 @@ def run_replay(
     if not args.no_stdin:
         threading.Thread(target=_read_commands, args=(book, done), name="replay-stdin", daemon=True).start()
     elif args.stop_with_stdin:
-        from app.sim.cli import _wait_for_end_of_stdin
-
-        threading.Thread(target=_wait_for_end_of_stdin, args=(done,), daemon=True).start()
+        threading.Thread(target=wait_for_end_of_stdin, args=(done,), daemon=True).start()
     try:
         while not done.wait(0.2):
             pass

@@ -5355,22 +5355,22 @@ Remove them all?</source>
     <context>
         <name>RegisterMapMenu</name>
         <message>
-            <location filename="../../ui/controllers/selftest_watch.py" line="148" />
+            <location filename="../../ui/controllers/selftest_watch.py" line="59" />
             <source>Check the controller's &amp;register map…</source>
             <translation>检查控制器的寄存器映射(&amp;R)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/selftest_watch.py" line="150" />
+            <location filename="../../ui/controllers/selftest_watch.py" line="62" />
             <source>Read the documented registers (nothing is written) and check them against the register profile</source>
             <translation>读取文档中定义的寄存器（不写入任何内容），并与寄存器配置核对</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/selftest_watch.py" line="178" />
+            <location filename="../../ui/controllers/selftest_watch.py" line="92" />
             <source>register map</source>
             <translation>寄存器映射</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/selftest_watch.py" line="180" />
+            <location filename="../../ui/controllers/selftest_watch.py" line="95" />
             <source>The controller's register map does not match the register profile: Help → Check the controller's register map…</source>
             <translation>控制器的寄存器映射与寄存器配置不一致：帮助 → 检查控制器的寄存器映射…</translation>
         </message>
@@ -6035,57 +6035,57 @@ Remove them all?</source>
     <context>
         <name>SelfTestDialog</name>
         <message>
-            <location filename="../../ui/dialogs/selftest_dialog.py" line="83" />
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="97" />
             <source>The controller's register map</source>
             <translation>控制器的寄存器映射</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/selftest_dialog.py" line="85" />
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="99" />
             <source>Check</source>
             <translation>检查</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/selftest_dialog.py" line="85" />
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="99" />
             <source>Result</source>
             <translation>结果</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/selftest_dialog.py" line="85" />
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="99" />
             <source>What was read</source>
             <translation>读到的内容</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/selftest_dialog.py" line="85" />
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="99" />
             <source>Likely fix</source>
             <translation>可能的解决办法</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/selftest_dialog.py" line="87" />
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="101" />
             <source>Check &amp;again</source>
             <translation>重新检查(&amp;A)</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/selftest_dialog.py" line="90" />
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="104" />
             <source>Only reads: nothing is written to the controller and nothing moves. The check runs by itself after every connect.</source>
             <translation>只读取：不向控制器写入任何内容，机器人不会运动。每次连接后都会自动检查。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/selftest_dialog.py" line="106" />
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="120" />
             <source>Not checked yet: connect to a controller first.</source>
             <translation>尚未检查：请先连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/selftest_dialog.py" line="112" />
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="126" />
             <source>Not connected to a controller: nothing can be read.</source>
             <translation>未连接控制器：无法读取。</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/selftest_dialog.py" line="116" />
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="130" />
             <source>Reading the controller's registers…</source>
             <translation>正在读取控制器的寄存器…</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/selftest_dialog.py" line="121" />
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="135" />
             <source>The registers could not be read: {why}</source>
             <translation>无法读取寄存器：{why}</translation>
         </message>
@@ -6093,302 +6093,302 @@ Remove them all?</source>
     <context>
         <name>SelfTestWords</name>
         <message>
-            <location filename="../../ui/selftest_words.py" line="31" />
+            <location filename="../../ui/selftest_words.py" line="32" />
             <source>Pose X Y Z A B C (word order)</source>
             <translation>位姿 X Y Z A B C（字序）</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="32" />
+            <location filename="../../ui/selftest_words.py" line="33" />
             <source>Pose from the joints (robot model)</source>
             <translation>由关节角算出的位姿（机器人模型）</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="33" />
+            <location filename="../../ui/selftest_words.py" line="34" />
             <source>Controller mode (560)</source>
             <translation>控制器模式（560）</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="34" />
+            <location filename="../../ui/selftest_words.py" line="35" />
             <source>Program state (561)</source>
             <translation>程序状态（561）</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="35" />
+            <location filename="../../ui/selftest_words.py" line="36" />
             <source>Alarm bits (562)</source>
             <translation>报警位（562）</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="36" />
+            <location filename="../../ui/selftest_words.py" line="37" />
             <source>Date and time (576–579)</source>
             <translation>日期和时间（576–579）</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="37" />
+            <location filename="../../ui/selftest_words.py" line="38" />
             <source>Command status (GV291)</source>
             <translation>命令返回状态（GV291）</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="38" />
+            <location filename="../../ui/selftest_words.py" line="39" />
             <source>Program motion mode (447)</source>
             <translation>程序运动模式（447）</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="39" />
+            <location filename="../../ui/selftest_words.py" line="40" />
             <source>Program speed ratio (449)</source>
             <translation>程序速度比例（449）</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="40" />
+            <location filename="../../ui/selftest_words.py" line="41" />
             <source>Status registers (560–583)</source>
             <translation>状态寄存器（560–583）</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="43" />
+            <location filename="../../ui/selftest_words.py" line="44" />
             <source>matches</source>
             <translation>一致</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="44" />
+            <location filename="../../ui/selftest_words.py" line="45" />
             <source>does not match</source>
             <translation>不一致</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="45" />
+            <location filename="../../ui/selftest_words.py" line="46" />
             <source>not checked</source>
             <translation>未检查</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="48" />
+            <location filename="../../ui/selftest_words.py" line="49" />
             <source>The controller refused the read of registers {what} (Modbus exception {exception}).</source>
             <translation>控制器拒绝读取寄存器 {what}（Modbus 异常 {exception}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="51" />
+            <location filename="../../ui/selftest_words.py" line="52" />
             <source>X Y Z A B C are all 0: nothing to judge.</source>
             <translation>X Y Z A B C 全为 0：无法判断。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="52" />
+            <location filename="../../ui/selftest_words.py" line="53" />
             <source>Read {order}, the pose is one a robot can stand at: {pose}.</source>
             <translation>按{order}读取，位姿是机器人可以到达的：{pose}。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="53" />
+            <location filename="../../ui/selftest_words.py" line="56" />
             <source>Read {order}, the pose is {pose}; read {other}, it is {other_pose}.</source>
             <translation>按{order}读取，位姿为 {pose}；按{other}读取，则为 {other_pose}。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="56" />
+            <location filename="../../ui/selftest_words.py" line="59" />
             <source>X Y Z A B C read either way are no pose a robot stands at: {pose}.</source>
             <translation>X Y Z A B C 无论按哪种字序读取都不是机器人可能的位姿：{pose}。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="59" />
+            <location filename="../../ui/selftest_words.py" line="62" />
             <source>No robot model to compute the pose with.</source>
             <translation>没有用于计算位姿的机器人模型。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="60" />
+            <location filename="../../ui/selftest_words.py" line="63" />
             <source>The controller publishes no joint angles in GV250–GV255 (a TeachPad extension): the pose cannot be computed from them.</source>
             <translation>控制器未在 GV250–GV255 中发布关节角（TeachPad 扩展）：无法由关节角计算位姿。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="65" />
+            <location filename="../../ui/selftest_words.py" line="68" />
             <source>The robot model “{model}” computes the pose from the joints within {mm} mm and {deg}°.</source>
             <translation>机器人模型“{model}”由关节角算出的位姿与控制器的位姿相差不超过 {mm} mm 和 {deg}°。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="68" />
+            <location filename="../../ui/selftest_words.py" line="72" />
             <source>The robot model “{model}” does not compute the pose from the joints read {order}; read {other}, it does.</source>
             <translation>按{order}读取时，机器人模型“{model}”由关节角算不出控制器的位姿；按{other}读取则可以。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="72" />
+            <location filename="../../ui/selftest_words.py" line="77" />
             <source>The joints or the pose are not finite numbers, read either way.</source>
             <translation>无论按哪种字序读取，关节角或位姿都不是有限数值。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="75" />
+            <location filename="../../ui/selftest_words.py" line="80" />
             <source>The robot model “{model}” computes the pose from the joints only if the controller reports {reading}; TeachPad reads mm, degrees and fixed-axis X-Y-Z angles.</source>
             <translation>只有当控制器报告的是{reading}时，机器人模型“{model}”才能由关节角算出其位姿；TeachPad 按毫米、度和固定轴 X-Y-Z 角读取。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="80" />
+            <location filename="../../ui/selftest_words.py" line="85" />
             <source>The robot model “{model}” puts the pose {mm} mm and {deg}° from the one the controller reports.</source>
             <translation>机器人模型“{model}”算出的位姿与控制器报告的位姿相差 {mm} mm 和 {deg}°。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="84" />
+            <location filename="../../ui/selftest_words.py" line="89" />
             <source>Register {register} = {value} ({meaning}).</source>
             <translation>寄存器 {register} = {value}（{meaning}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="85" />
+            <location filename="../../ui/selftest_words.py" line="90" />
             <source>Register {register} = {value}: not one of its table's values ({allowed}).</source>
             <translation>寄存器 {register} = {value}：不在其取值表中（{allowed}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="88" />
+            <location filename="../../ui/selftest_words.py" line="93" />
             <source>Register 562 = {value} (alarms on: {alarms}).</source>
             <translation>寄存器 562 = {value}（当前报警：{alarms}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="89" />
+            <location filename="../../ui/selftest_words.py" line="94" />
             <source>Register 562 = {value}: bits {bits} are none of the five documented alarms.</source>
             <translation>寄存器 562 = {value}：位 {bits} 不属于文档中的五种报警。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="92" />
+            <location filename="../../ui/selftest_words.py" line="97" />
             <source>The date/time registers are all 0.</source>
             <translation>日期/时间寄存器全为 0。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="93" />
+            <location filename="../../ui/selftest_words.py" line="98" />
             <source>The controller's clock reads {clock}, this PC's {pc}.</source>
             <translation>控制器时钟为 {clock}，本机时钟为 {pc}。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="94" />
+            <location filename="../../ui/selftest_words.py" line="99" />
             <source>The date/time words ({raw}) read as {other} are this PC's time ({other_clock}).</source>
             <translation>日期/时间字（{raw}）按{other}读取才是本机时间（{other_clock}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="97" />
+            <location filename="../../ui/selftest_words.py" line="102" />
             <source>The date/time words ({raw}) are no date in either layout.</source>
             <translation>日期/时间字（{raw}）按两种格式都不是有效日期。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="98" />
+            <location filename="../../ui/selftest_words.py" line="105" />
             <source>The controller's clock reads {clock}: {apart} ahead of this PC's ({pc}).</source>
             <translation>控制器时钟为 {clock}：比本机时钟（{pc}）快 {apart}。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="101" />
+            <location filename="../../ui/selftest_words.py" line="108" />
             <source>The controller's clock reads {clock}: {apart} behind this PC's ({pc}).</source>
             <translation>控制器时钟为 {clock}：比本机时钟（{pc}）慢 {apart}。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="104" />
+            <location filename="../../ui/selftest_words.py" line="111" />
             <source>GV291 = {value} ({meaning}).</source>
             <translation>GV291 = {value}（{meaning}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="105" />
+            <location filename="../../ui/selftest_words.py" line="112" />
             <source>GV291's words ({raw}) are no status code read {order}; read {other}, they are {other_value}.</source>
             <translation>GV291 的两个字（{raw}）按{order}读取不是状态码；按{other}读取则为 {other_value}。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="108" />
+            <location filename="../../ui/selftest_words.py" line="116" />
             <source>GV291's words ({raw}) are none of the documented status codes.</source>
             <translation>GV291 的两个字（{raw}）不是文档中的任何状态码。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="111" />
+            <location filename="../../ui/selftest_words.py" line="119" />
             <source>Register {register} = {value} (within {low}–{high}).</source>
             <translation>寄存器 {register} = {value}（在 {low}–{high} 之内）。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="112" />
+            <location filename="../../ui/selftest_words.py" line="120" />
             <source>Register {register} = {value}: outside {low}–{high}.</source>
             <translation>寄存器 {register} = {value}：超出 {low}–{high}。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="115" />
+            <location filename="../../ui/selftest_words.py" line="125" />
             <source>Set the register profile's {field} to {value} (Safety → Register profile…), then connect again.</source>
             <translation>请把寄存器配置的{field}设为{value}（安全 → 寄存器配置…），然后重新连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="119" />
+            <location filename="../../ui/selftest_words.py" line="129" />
             <source>Check the unit id, and that this controller has the vendor document's register map.</source>
             <translation>请检查从站地址，并确认该控制器使用厂家文档中的寄存器映射。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="122" />
+            <location filename="../../ui/selftest_words.py" line="132" />
             <source>Not a register profile setting: set the controller to mm, degrees and fixed-axis X-Y-Z angles, or tell the TeachPad team.</source>
             <translation>这不是寄存器配置中的设置：请把控制器设为毫米、度和固定轴 X-Y-Z 角，或告知 TeachPad 团队。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="127" />
+            <location filename="../../ui/selftest_words.py" line="137" />
             <source>Load the robot model of this arm (3D view → Robot model…), or check the joint registers.</source>
             <translation>请加载该机械臂的机器人模型（3D 视图 → 机器人模型…），或检查关节寄存器。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="130" />
+            <location filename="../../ui/selftest_words.py" line="141" />
             <source>Set the controller's clock (or this PC's): not a register profile setting.</source>
             <translation>请校准控制器的时钟（或本机时钟）：这不是寄存器配置中的设置。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="135" />
+            <location filename="../../ui/selftest_words.py" line="146" />
             <source>word order</source>
             <translation>字序</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="136" />
+            <location filename="../../ui/selftest_words.py" line="147" />
             <source>date/time layout</source>
             <translation>日期/时间格式</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="139" />
+            <location filename="../../ui/selftest_words.py" line="150" />
             <source>split words (year, month·day)</source>
-            <translation>分字（年、月·日）</translation>
+            <translation>分两个寄存器（年、月·日）</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="140" />
+            <location filename="../../ui/selftest_words.py" line="151" />
             <source>packed 32-bit values</source>
             <translation>打包的 32 位值</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="143" />
+            <location filename="../../ui/selftest_words.py" line="154" />
             <source>the position in metres</source>
             <translation>以米为单位的位置</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="144" />
+            <location filename="../../ui/selftest_words.py" line="155" />
             <source>the joints in radians</source>
             <translation>以弧度为单位的关节角</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="145" />
+            <location filename="../../ui/selftest_words.py" line="156" />
             <source>A B C as rotating-axis X-Y'-Z'' angles (fixed Z-Y-X)</source>
             <translation>动轴 X-Y'-Z'' 角（即定轴 Z-Y-X）表示的 A B C</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="148" />
+            <location filename="../../ui/selftest_words.py" line="159" />
             <source>A B C as Z-Y-Z Euler angles</source>
             <translation>Z-Y-Z 欧拉角表示的 A B C</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="149" />
+            <location filename="../../ui/selftest_words.py" line="160" />
             <source>A B C in radians</source>
             <translation>以弧度为单位的 A B C</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="151" />
+            <location filename="../../ui/selftest_words.py" line="162" />
             <source>{n} days</source>
             <translation>{n} 天</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="152" />
+            <location filename="../../ui/selftest_words.py" line="163" />
             <source>{n} h</source>
             <translation>{n} 小时</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="153" />
+            <location filename="../../ui/selftest_words.py" line="164" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="154" />
+            <location filename="../../ui/selftest_words.py" line="165" />
             <source>none</source>
             <translation>无</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="155" />
+            <location filename="../../ui/selftest_words.py" line="166" />
             <source>The register map matches the register profile: {match} checks matched, {unchecked} not checked.</source>
             <translation>寄存器映射与寄存器配置一致：{match} 项一致，{unchecked} 项未检查。</translation>
         </message>
         <message>
-            <location filename="../../ui/selftest_words.py" line="158" />
+            <location filename="../../ui/selftest_words.py" line="170" />
             <source>The register map does not match the register profile: {mismatch} of {total} checks do not match.</source>
             <translation>寄存器映射与寄存器配置不一致：{total} 项检查中有 {mismatch} 项不一致。</translation>
         </message>

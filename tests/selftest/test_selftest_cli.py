@@ -21,7 +21,7 @@ from app.link.register_reads import RegisterBlocks, read_blocks
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
 from app.safety.register_profile import RegisterProfile, save_register_profile
-from app.selftest.checks import SELFTEST_BLOCKS, Verdict, check_register_map
+from app.selftest.checks import SELFTEST_BLOCKS, CheckVerdict, check_register_map
 from app.view3d.kinematics import ArmModel
 from app.view3d.profile import default_profile, profile_to_dict
 
@@ -137,8 +137,8 @@ def test_a_refused_block_is_not_checked_and_does_not_fail(sim: Any, make_client:
         read, WordOrder.LOW_FIRST, DateTimeLayout.SPLIT_WORDS, ArmModel(default_profile())
     )
     verdicts = {line.check: line.verdict for line in report.lines}
-    assert verdicts["status"] is Verdict.UNCHECKED
-    assert verdicts["pose"] is Verdict.MATCH
+    assert verdicts["status"] is CheckVerdict.UNCHECKED
+    assert verdicts["pose"] is CheckVerdict.MATCH
     assert report.passed
 
 

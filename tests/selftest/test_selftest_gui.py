@@ -14,7 +14,7 @@ from PySide6.QtCore import QPoint
 from PySide6.QtGui import QPainter, QPixmap
 
 from app.protocol.codec import WordOrder
-from app.selftest.checks import SelfTestReport, Verdict
+from app.selftest.checks import CheckVerdict, SelfTestReport
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,
@@ -70,7 +70,7 @@ def test_after_a_connect_the_other_word_order_is_reported_and_fixed_by_the_profi
     with qtbot.waitSignal(check.reported, timeout=SIGNAL_TIMEOUT_MS) as fixed:
         connect(qtbot, window.link, sim, poll_timeout=1.0, word_order=WordOrder.HIGH_FIRST)
     assert fixed.args[0].passed, [line.line for line in fixed.args[0].lines]
-    assert {line.verdict for line in fixed.args[0].lines} == {Verdict.MATCH}
+    assert {line.verdict for line in fixed.args[0].lines} == {CheckVerdict.MATCH}
     assert len(register_map_warnings(window)) == 1  # nothing new said
 
 

@@ -3,7 +3,7 @@
 One row per check (:mod:`app.selftest.checks`): the check, its verdict (matches, does not match,
 not checked), what was found and the likely fix, in the operator's language
 (:mod:`ui.selftest_words`). *Check again* reads the registers again (in the link's worker; nothing
-is written). The dialog follows its :class:`~ui.controllers.selftest_watch.RegisterMapCheck`: a
+is written). The dialog follows its :class:`~ui.controllers.register_map_check.RegisterMapCheck`: a
 report made after every connect shows here too.
 """
 
@@ -24,14 +24,18 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.selftest.checks import SelfTestReport, Verdict
-from ui.controllers.selftest_watch import RegisterMapCheck
+from app.selftest.checks import CheckVerdict, SelfTestReport
+from ui.controllers.register_map_check import RegisterMapCheck
 from ui.palette import COLOR_ERROR, COLOR_NEUTRAL, COLOR_OK
 from ui.selftest_words import check_name, fix_text, found_text, summary_text, verdict_text
 
 __all__ = ["SelfTestDialog"]
 
-_VERDICT_COLOR = {Verdict.MATCH: COLOR_OK, Verdict.MISMATCH: COLOR_ERROR, Verdict.UNCHECKED: COLOR_NEUTRAL}
+_VERDICT_COLOR = {
+    CheckVerdict.MATCH: COLOR_OK,
+    CheckVerdict.MISMATCH: COLOR_ERROR,
+    CheckVerdict.UNCHECKED: COLOR_NEUTRAL,
+}
 COLUMNS = 4  # check, verdict, found, fix
 
 
