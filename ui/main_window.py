@@ -62,6 +62,7 @@ from ui.controllers.point_sync import PointSyncController
 from ui.controllers.project_controller import ProjectController
 from ui.controllers.project_dialogs import ProjectDialogs
 from ui.controllers.safety_menu import SafetyParts, install_safety
+from ui.controllers.selftest_watch import install_register_map_check
 from ui.controllers.word_order_watch import WordOrderWatch
 from ui.dialogs.confirm import ConfirmFn
 from ui.i18n import Translator
@@ -197,6 +198,7 @@ class MainWindow(QMainWindow):
         self.motion.safety = self.safety_menu.safety
         self.run_controller.audit = self.safety_menu.safety.session.audit  # a run's own pause (issue 19)
         self.cell = install_cell(self)  # File → Open cell…, the Cell tab (issue 23)
+        self.register_map_check = install_register_map_check(self)  # Help → register map (issue 24)
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])

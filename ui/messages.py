@@ -306,6 +306,7 @@ _OPERATIONS: dict[str, str] = {  # app.link.types.Operation values
     "disconnect": QT_TRANSLATE_NOOP("Messages", "disconnect"),
     "shutdown": QT_TRANSLATE_NOOP("Messages", "shutdown"),
     "restart check": QT_TRANSLATE_NOOP("Messages", "restart check"),
+    "read registers": QT_TRANSLATE_NOOP("Messages", "read registers"),
 }
 _AN_OPERATION = QT_TRANSLATE_NOOP("Messages", "request")
 

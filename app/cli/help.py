@@ -34,6 +34,7 @@ EXAMPLES: dict[str, str] = {
     "points export": "teachpad-cli points export cell.teachpad.json --csv points.csv",
     "points import": "teachpad-cli points import cell.teachpad.json --csv points.csv --merge",
     "run": "teachpad-cli --host 192.168.1.10 run cell.teachpad.json --plan weld --from 3 --max-speed 250",
+    "selftest": "teachpad-cli --host 192.168.1.10 --register-profile cell.registers.json selftest",
     "support-bundle": "teachpad-cli support-bundle support.zip --project cell.teachpad.json --days 3",
     "audit": "teachpad-cli audit --from 2026-05-01 --to 2026-05-02T18:00 --result refused",
     "roles show": "teachpad-cli roles show",

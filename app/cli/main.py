@@ -16,6 +16,7 @@ Every command, by the module whose ``register`` adds it (:data:`REGISTRARS`, in 
   ``read``, ``write``
 * :mod:`app.cli.points`: ``points list | upload | export | import``
 * :mod:`app.cli.run_plan`: ``run``
+* :mod:`app.cli.selftest`: ``selftest`` (the register-map self-test, reads only)
 * :mod:`app.cli.support`: ``support-bundle``, ``audit``, ``roles`` (offline)
 
 Adding a command: give its module a ``register(subparsers)`` that adds the parser and sets
@@ -38,7 +39,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any
 
-from app.cli import controller, points, run_plan, support
+from app.cli import controller, points, run_plan, selftest, support
 from app.cli.context import PROG, CliContext, Handler, ctrl_c_remembered
 from app.cli.exit_codes import EPILOG, ExitCode, exit_code_for
 from app.cli.format import parse_positive_float, parse_word_order
@@ -85,6 +86,7 @@ REGISTRARS: tuple[Registrar, ...] = (
     controller.register,
     points.register,
     run_plan.register,
+    selftest.register,
     support.register,
 )
 

@@ -49,6 +49,7 @@ __all__ = [
     "LinkOp",
     "MoveToPoint",
     "Pause",
+    "ReadRegisters",
     "Resume",
     "RunProgram",
     "SetJogRatio",
@@ -259,6 +260,20 @@ class CancelUpload(LinkOp):
     operation: ClassVar[str] = Operation.CANCEL_UPLOAD
     kind: ClassVar[JobKind] = JobKind.URGENT
     needs_link: ClassVar[bool] = False
+
+
+@dataclass(frozen=True)
+class ReadRegisters(LinkOp):
+    """Read whole register blocks (start, count) with 0x03, nothing written; the worker's
+    ``registersRead`` carries what was read (:class:`~app.link.register_reads.RegisterBlocks`).
+    A block the controller refuses is kept as refused; the others are still read."""
+
+    operation: ClassVar[str] = Operation.READ_REGISTERS
+
+    blocks: tuple[tuple[int, int], ...]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "blocks", tuple((int(a), int(n)) for a, n in self.blocks))
 
 
 _Op = TypeVar("_Op", bound=LinkOp)

@@ -68,6 +68,7 @@ class RobotLink(QObject):
     uploadProgress = Signal(int, int)  # noqa: N815
     pointUploaded = Signal(int, bool, str, bool)  # noqa: N815
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard stopped a jog
+    registersRead = Signal(object)  # noqa: N815 - RegisterBlocks of a ReadRegisters op (its request_id)
 
     _connectRequested = Signal(object)  # noqa: N815
     _disconnectRequested = Signal()  # noqa: N815
@@ -156,6 +157,7 @@ class RobotLink(QObject):
             (w.uploadProgress, self.uploadProgress),
             (w.pointUploaded, self.pointUploaded),
             (w.jogGuardStopped, self.jogGuardStopped),
+            (w.registersRead, self.registersRead),
             (w.haltChanged, state.set_halt),
             (self._connectRequested, w.connect_to),
             (self._disconnectRequested, w.disconnect_link),

@@ -55,6 +55,7 @@ class Operation:
     DISCONNECT = "disconnect"
     SHUTDOWN = "shutdown"
     CANARY = "restart check"
+    READ_REGISTERS = "read registers"
 
 
 class LinkState(enum.Enum):

@@ -80,6 +80,7 @@ from app.link.jog import JogMachine, PreemptedError
 from app.link.motion import MotionCommands
 from app.link.ops import CancelUpload, Handlers, LinkOp, Stop
 from app.link.poller import Poller
+from app.link.register_reads import RegisterBlocks, RegisterReads
 from app.link.sequence import poll
 from app.link.state import PollUpdate
 from app.link.stats import LinkStats
@@ -128,6 +129,7 @@ class RobotWorker(QObject):
     pointUploaded = Signal(int, bool, str, bool)  # noqa: N815 - point id, ok, reason ("" when ok), unconfirmed
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard wrote ratio 0
     haltChanged = Signal(object)  # noqa: N815 - UnconfirmedHalt | None: a stop the controller has not confirmed
+    registersRead = Signal(object)  # noqa: N815 - RegisterBlocks: what a ReadRegisters op read
     stopped = Signal()  # the worker has closed the link and is quitting its thread (shutdown)
 
     # Wakes the worker from any thread (a queued call, since the worker lives in its thread).
@@ -175,6 +177,7 @@ class RobotWorker(QObject):
         )
         self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
         self.commands = WorkerCommands(self)  # the short commands' handlers
+        self.register_reads = RegisterReads(self)  # write-free block reads (the register-map self-test)
         self.handlers = self._make_handlers()
 
     def _make_handlers(self) -> Handlers:
@@ -183,6 +186,7 @@ class RobotWorker(QObject):
         handlers = Handlers()
         self.commands.register(handlers)  # the short ones (stop, pause, the jog ...)
         self.motions.register(handlers)  # the long ones (step, move to point ...)
+        self.register_reads.register(handlers)  # block reads
         return handlers
 
     # --- requests (any thread) ----------------------------------------------------------
@@ -416,6 +420,10 @@ class RobotWorker(QObject):
 
     def publish_halt(self, halt: UnconfirmedHalt | None) -> None:
         self.haltChanged.emit(halt)
+
+    def publish_registers(self, blocks: RegisterBlocks) -> None:
+        self.flush_traffic()  # the reads' frames reach the GUI before what they read
+        self.registersRead.emit(blocks)
 
     def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None:
         """``commandFinished`` with the request id (default: the job being executed)."""

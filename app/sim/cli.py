@@ -134,6 +134,14 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument(
         "--idle", action="store_true", help="with --controllers: no program runs (the arms stand still)"
     )
+    parser.add_argument(
+        "--replay",
+        metavar="CAPTURE",
+        help="answer every request with what the captured controller answered: CAPTURE is the traffic "
+        "inspector's export (.csv or .txt) or a support bundle (.zip); matched by function, address "
+        "and order; what cannot be matched is logged and answered with Modbus exception 4 (TCP only; "
+        "stdin: status, quit)",
+    )
     parser.add_argument("--no-stdin", action="store_true", help="do not read commands from stdin")
     parser.add_argument(
         "--stop-with-stdin",
@@ -266,6 +274,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.controllers is not None and args.serial:
         parser.error("--controllers serves TCP ports; it cannot be used with --serial")
+    if args.replay is not None:
+        return _replay(parser, args)
     _configure_logging(args.verbose)
     config = _sim_config(args)
     fleet = _started_fleet(args, config)
@@ -294,6 +304,16 @@ def main(argv: Sequence[str] | None = None) -> int:
             signal.signal(sig, handler)  # type: ignore[arg-type]
     _say("teachpad-sim stopped")
     return 0
+
+
+def _replay(parser: argparse.ArgumentParser, args: argparse.Namespace) -> int:
+    """``--replay CAPTURE``: a traffic capture answers instead of the simulated robot."""
+    if args.serial or args.controllers is not None:
+        parser.error("--replay serves one TCP port; it cannot be used with --serial or --controllers")
+    _configure_logging(args.verbose)
+    from app.sim.replay_cli import run_replay
+
+    return run_replay(args, _stop_on_signals, _say, _wait_for_end_of_stdin)
 
 
 def _started_fleet(args: argparse.Namespace, config: SimConfig) -> SimFleet | None:

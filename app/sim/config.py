@@ -46,6 +46,7 @@ class SimConfig:
     timing: Literal["classic", "fast", "slow"] = "classic"  # GV291 timing profile (app.sim.status)
     gv291: Literal["ignored", "writable", "read-only"] = "ignored"  # what a host's write to GV291 does
     seed: int = 0  # of the "slow" profile's jitter
+    clock_offset: float = 0.0  # s the controller's clock (GV288/289) is ahead of the PC's (negative: behind)
 
     def __post_init__(self) -> None:
         if isinstance(self.word_order, str):

@@ -75,7 +75,8 @@ class RegisterImage:
         regs[REG_CONTROLLER_MODE - start] = int(robot.controller_mode)
         regs[REG_PROGRAM_STATE - start] = int(robot.program_state)
         regs[REG_ALARMS - start] = int(robot.alarms) & 0xFFFF
-        clock = encode_clock(dt.datetime.now(), self.config.datetime_layout)
+        now = dt.datetime.now() + dt.timedelta(seconds=self.config.clock_offset)
+        clock = encode_clock(now, self.config.datetime_layout)
         d = gv_reg(GV_DATE) - start
         regs[d : d + 4] = clock
         s = gv_reg(GV_COMMAND_STATUS) - start

@@ -1664,7 +1664,7 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="354" />
+            <location filename="../../ui/main_window.py" line="356" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
@@ -1695,7 +1695,7 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>往返 —</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="400" />
+            <location filename="../../ui/main_window.py" line="402" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
@@ -1720,30 +1720,30 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>此控制器上还有另一个 Modbus 主站：{sign}。它与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。请检查还有谁连接着控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="423" />
+            <location filename="../../ui/main_window.py" line="425" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="378" />
-            <location filename="../../ui/main_window.py" line="402" />
-            <location filename="../../ui/main_window.py" line="411" />
-            <location filename="../../ui/main_window.py" line="424" />
+            <location filename="../../ui/main_window.py" line="380" />
+            <location filename="../../ui/main_window.py" line="404" />
+            <location filename="../../ui/main_window.py" line="413" />
+            <location filename="../../ui/main_window.py" line="426" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="331" />
+            <location filename="../../ui/main_window.py" line="333" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="332" />
+            <location filename="../../ui/main_window.py" line="334" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="333" />
+            <location filename="../../ui/main_window.py" line="335" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1753,37 +1753,37 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="418" />
+            <location filename="../../ui/main_window.py" line="420" />
             <source>plan run</source>
             <translation>计划运行</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="498" />
+            <location filename="../../ui/main_window.py" line="500" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="500" />
+            <location filename="../../ui/main_window.py" line="502" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="513" />
+            <location filename="../../ui/main_window.py" line="515" />
             <source>Safety state (roles, envelope, audit trail), machine-wide: {folder}</source>
             <translation>安全状态（角色、安全范围、审计记录），本机共用：{folder}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="515" />
+            <location filename="../../ui/main_window.py" line="517" />
             <source>Safety state (roles, envelope), this user's: {folder}&lt;br&gt;Audit trail: {audit}</source>
             <translation>安全状态（角色、安全范围），当前用户：{folder}&lt;br&gt;审计记录：{audit}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="534" />
+            <location filename="../../ui/main_window.py" line="536" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="534" />
+            <location filename="../../ui/main_window.py" line="536" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -2467,162 +2467,167 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="310" />
+            <location filename="../../ui/messages.py" line="309" />
+            <source>read registers</source>
+            <translation>读取寄存器</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="311" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="313" />
+            <location filename="../../ui/messages.py" line="314" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="314" />
+            <location filename="../../ui/messages.py" line="315" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="315" />
+            <location filename="../../ui/messages.py" line="316" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="316" />
+            <location filename="../../ui/messages.py" line="317" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="317" />
+            <location filename="../../ui/messages.py" line="318" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="318" />
+            <location filename="../../ui/messages.py" line="319" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="319" />
+            <location filename="../../ui/messages.py" line="320" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="320" />
+            <location filename="../../ui/messages.py" line="321" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="321" />
+            <location filename="../../ui/messages.py" line="322" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="322" />
+            <location filename="../../ui/messages.py" line="323" />
             <source>unit id</source>
             <translation>从站地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="323" />
+            <location filename="../../ui/messages.py" line="324" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="327" />
+            <location filename="../../ui/messages.py" line="328" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="328" />
+            <location filename="../../ui/messages.py" line="329" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="329" />
+            <location filename="../../ui/messages.py" line="330" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="330" />
+            <location filename="../../ui/messages.py" line="331" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="331" />
+            <location filename="../../ui/messages.py" line="332" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="332" />
+            <location filename="../../ui/messages.py" line="333" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="333" />
+            <location filename="../../ui/messages.py" line="334" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="334" />
+            <location filename="../../ui/messages.py" line="335" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="335" />
+            <location filename="../../ui/messages.py" line="336" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="336" />
+            <location filename="../../ui/messages.py" line="337" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="338" />
+            <location filename="../../ui/messages.py" line="339" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="531" />
+            <location filename="../../ui/messages.py" line="532" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="534" />
+            <location filename="../../ui/messages.py" line="535" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="580" />
+            <location filename="../../ui/messages.py" line="581" />
             <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
             <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="583" />
+            <location filename="../../ui/messages.py" line="584" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="587" />
+            <location filename="../../ui/messages.py" line="588" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="590" />
+            <location filename="../../ui/messages.py" line="591" />
             <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="593" />
+            <location filename="../../ui/messages.py" line="594" />
             <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="623" />
+            <location filename="../../ui/messages.py" line="624" />
             <source>{operation}: not sent, cancelled by Stop.</source>
             <translation>{operation}：未发送，已被停止取消。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="624" />
+            <location filename="../../ui/messages.py" line="625" />
             <source>{operation}: not sent, the upload was cancelled.</source>
             <translation>{operation}：未发送，上传已取消。</translation>
         </message>
@@ -2672,12 +2677,12 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="540" />
+            <location filename="../../ui/messages.py" line="541" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="544" />
+            <location filename="../../ui/messages.py" line="545" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -5348,6 +5353,29 @@ Remove them all?</source>
         </message>
     </context>
     <context>
+        <name>RegisterMapMenu</name>
+        <message>
+            <location filename="../../ui/controllers/selftest_watch.py" line="59" />
+            <source>Check the controller's &amp;register map…</source>
+            <translation>检查控制器的寄存器映射(&amp;R)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/selftest_watch.py" line="62" />
+            <source>Read the documented registers (nothing is written) and check them against the register profile</source>
+            <translation>读取文档中定义的寄存器（不写入任何内容），并与寄存器配置核对</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/selftest_watch.py" line="92" />
+            <source>register map</source>
+            <translation>寄存器映射</translation>
+        </message>
+        <message>
+            <location filename="../../ui/controllers/selftest_watch.py" line="95" />
+            <source>The controller's register map does not match the register profile: Help → Check the controller's register map…</source>
+            <translation>控制器的寄存器映射与寄存器配置不一致：帮助 → 检查控制器的寄存器映射…</translation>
+        </message>
+    </context>
+    <context>
         <name>RegisterProfileDialog</name>
         <message>
             <location filename="../../ui/dialogs/register_profile_dialog.py" line="152" />
@@ -6002,6 +6030,367 @@ Remove them all?</source>
             <location filename="../../ui/models/segment_model.py" line="446" />
             <source>Move segment down</source>
             <translation>下移段</translation>
+        </message>
+    </context>
+    <context>
+        <name>SelfTestDialog</name>
+        <message>
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="97" />
+            <source>The controller's register map</source>
+            <translation>控制器的寄存器映射</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="99" />
+            <source>Check</source>
+            <translation>检查</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="99" />
+            <source>Result</source>
+            <translation>结果</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="99" />
+            <source>What was read</source>
+            <translation>读到的内容</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="99" />
+            <source>Likely fix</source>
+            <translation>可能的解决办法</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="101" />
+            <source>Check &amp;again</source>
+            <translation>重新检查(&amp;A)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="104" />
+            <source>Only reads: nothing is written to the controller and nothing moves. The check runs by itself after every connect.</source>
+            <translation>只读取：不向控制器写入任何内容，机器人不会运动。每次连接后都会自动检查。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="120" />
+            <source>Not checked yet: connect to a controller first.</source>
+            <translation>尚未检查：请先连接控制器。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="126" />
+            <source>Not connected to a controller: nothing can be read.</source>
+            <translation>未连接控制器：无法读取。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="130" />
+            <source>Reading the controller's registers…</source>
+            <translation>正在读取控制器的寄存器…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/selftest_dialog.py" line="135" />
+            <source>The registers could not be read: {why}</source>
+            <translation>无法读取寄存器：{why}</translation>
+        </message>
+    </context>
+    <context>
+        <name>SelfTestWords</name>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="32" />
+            <source>Pose X Y Z A B C (word order)</source>
+            <translation>位姿 X Y Z A B C（字序）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="33" />
+            <source>Pose from the joints (robot model)</source>
+            <translation>由关节角算出的位姿（机器人模型）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="34" />
+            <source>Controller mode (560)</source>
+            <translation>控制器模式（560）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="35" />
+            <source>Program state (561)</source>
+            <translation>程序状态（561）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="36" />
+            <source>Alarm bits (562)</source>
+            <translation>报警位（562）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="37" />
+            <source>Date and time (576–579)</source>
+            <translation>日期和时间（576–579）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="38" />
+            <source>Command status (GV291)</source>
+            <translation>命令返回状态（GV291）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="39" />
+            <source>Program motion mode (447)</source>
+            <translation>程序运动模式（447）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="40" />
+            <source>Program speed ratio (449)</source>
+            <translation>程序速度比例（449）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="41" />
+            <source>Status registers (560–583)</source>
+            <translation>状态寄存器（560–583）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="44" />
+            <source>matches</source>
+            <translation>一致</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="45" />
+            <source>does not match</source>
+            <translation>不一致</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="46" />
+            <source>not checked</source>
+            <translation>未检查</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="49" />
+            <source>The controller refused the read of registers {what} (Modbus exception {exception}).</source>
+            <translation>控制器拒绝读取寄存器 {what}（Modbus 异常 {exception}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="52" />
+            <source>X Y Z A B C are all 0: nothing to judge.</source>
+            <translation>X Y Z A B C 全为 0：无法判断。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="53" />
+            <source>Read {order}, the pose is one a robot can stand at: {pose}.</source>
+            <translation>按{order}读取，位姿是机器人可以到达的：{pose}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="56" />
+            <source>Read {order}, the pose is {pose}; read {other}, it is {other_pose}.</source>
+            <translation>按{order}读取，位姿为 {pose}；按{other}读取，则为 {other_pose}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="59" />
+            <source>X Y Z A B C read either way are no pose a robot stands at: {pose}.</source>
+            <translation>X Y Z A B C 无论按哪种字序读取都不是机器人可能的位姿：{pose}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="62" />
+            <source>No robot model to compute the pose with.</source>
+            <translation>没有用于计算位姿的机器人模型。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="63" />
+            <source>The controller publishes no joint angles in GV250–GV255 (a TeachPad extension): the pose cannot be computed from them.</source>
+            <translation>控制器未在 GV250–GV255 中发布关节角（TeachPad 扩展）：无法由关节角计算位姿。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="68" />
+            <source>The robot model “{model}” computes the pose from the joints within {mm} mm and {deg}°.</source>
+            <translation>机器人模型“{model}”由关节角算出的位姿与控制器的位姿相差不超过 {mm} mm 和 {deg}°。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="72" />
+            <source>The robot model “{model}” does not compute the pose from the joints read {order}; read {other}, it does.</source>
+            <translation>按{order}读取时，机器人模型“{model}”由关节角算不出控制器的位姿；按{other}读取则可以。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="77" />
+            <source>The joints or the pose are not finite numbers, read either way.</source>
+            <translation>无论按哪种字序读取，关节角或位姿都不是有限数值。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="80" />
+            <source>The robot model “{model}” computes the pose from the joints only if the controller reports {reading}; TeachPad reads mm, degrees and fixed-axis X-Y-Z angles.</source>
+            <translation>只有当控制器报告的是{reading}时，机器人模型“{model}”才能由关节角算出其位姿；TeachPad 按毫米、度和固定轴 X-Y-Z 角读取。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="85" />
+            <source>The robot model “{model}” puts the pose {mm} mm and {deg}° from the one the controller reports.</source>
+            <translation>机器人模型“{model}”算出的位姿与控制器报告的位姿相差 {mm} mm 和 {deg}°。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="89" />
+            <source>Register {register} = {value} ({meaning}).</source>
+            <translation>寄存器 {register} = {value}（{meaning}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="90" />
+            <source>Register {register} = {value}: not one of its table's values ({allowed}).</source>
+            <translation>寄存器 {register} = {value}：不在其取值表中（{allowed}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="93" />
+            <source>Register 562 = {value} (alarms on: {alarms}).</source>
+            <translation>寄存器 562 = {value}（当前报警：{alarms}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="94" />
+            <source>Register 562 = {value}: bits {bits} are none of the five documented alarms.</source>
+            <translation>寄存器 562 = {value}：位 {bits} 不属于文档中的五种报警。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="97" />
+            <source>The date/time registers are all 0.</source>
+            <translation>日期/时间寄存器全为 0。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="98" />
+            <source>The controller's clock reads {clock}, this PC's {pc}.</source>
+            <translation>控制器时钟为 {clock}，本机时钟为 {pc}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="99" />
+            <source>The date/time words ({raw}) read as {other} are this PC's time ({other_clock}).</source>
+            <translation>日期/时间字（{raw}）按{other}读取才是本机时间（{other_clock}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="102" />
+            <source>The date/time words ({raw}) are no date in either layout.</source>
+            <translation>日期/时间字（{raw}）按两种格式都不是有效日期。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="105" />
+            <source>The controller's clock reads {clock}: {apart} ahead of this PC's ({pc}).</source>
+            <translation>控制器时钟为 {clock}：比本机时钟（{pc}）快 {apart}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="108" />
+            <source>The controller's clock reads {clock}: {apart} behind this PC's ({pc}).</source>
+            <translation>控制器时钟为 {clock}：比本机时钟（{pc}）慢 {apart}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="111" />
+            <source>GV291 = {value} ({meaning}).</source>
+            <translation>GV291 = {value}（{meaning}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="112" />
+            <source>GV291's words ({raw}) are no status code read {order}; read {other}, they are {other_value}.</source>
+            <translation>GV291 的两个字（{raw}）按{order}读取不是状态码；按{other}读取则为 {other_value}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="116" />
+            <source>GV291's words ({raw}) are none of the documented status codes.</source>
+            <translation>GV291 的两个字（{raw}）不是文档中的任何状态码。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="119" />
+            <source>Register {register} = {value} (within {low}–{high}).</source>
+            <translation>寄存器 {register} = {value}（在 {low}–{high} 之内）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="120" />
+            <source>Register {register} = {value}: outside {low}–{high}.</source>
+            <translation>寄存器 {register} = {value}：超出 {low}–{high}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="125" />
+            <source>Set the register profile's {field} to {value} (Safety → Register profile…), then connect again.</source>
+            <translation>请把寄存器配置的{field}设为{value}（安全 → 寄存器配置…），然后重新连接。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="129" />
+            <source>Check the unit id, and that this controller has the vendor document's register map.</source>
+            <translation>请检查从站地址，并确认该控制器使用厂家文档中的寄存器映射。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="132" />
+            <source>Not a register profile setting: set the controller to mm, degrees and fixed-axis X-Y-Z angles, or tell the TeachPad team.</source>
+            <translation>这不是寄存器配置中的设置：请把控制器设为毫米、度和固定轴 X-Y-Z 角，或告知 TeachPad 团队。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="137" />
+            <source>Load the robot model of this arm (3D view → Robot model…), or check the joint registers.</source>
+            <translation>请加载该机械臂的机器人模型（3D 视图 → 机器人模型…），或检查关节寄存器。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="141" />
+            <source>Set the controller's clock (or this PC's): not a register profile setting.</source>
+            <translation>请校准控制器的时钟（或本机时钟）：这不是寄存器配置中的设置。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="146" />
+            <source>word order</source>
+            <translation>字序</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="147" />
+            <source>date/time layout</source>
+            <translation>日期/时间格式</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="150" />
+            <source>split words (year, month·day)</source>
+            <translation>分两个寄存器（年、月·日）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="151" />
+            <source>packed 32-bit values</source>
+            <translation>打包的 32 位值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="154" />
+            <source>the position in metres</source>
+            <translation>以米为单位的位置</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="155" />
+            <source>the joints in radians</source>
+            <translation>以弧度为单位的关节角</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="156" />
+            <source>A B C as rotating-axis X-Y'-Z'' angles (fixed Z-Y-X)</source>
+            <translation>动轴 X-Y'-Z'' 角（即定轴 Z-Y-X）表示的 A B C</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="159" />
+            <source>A B C as Z-Y-Z Euler angles</source>
+            <translation>Z-Y-Z 欧拉角表示的 A B C</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="160" />
+            <source>A B C in radians</source>
+            <translation>以弧度为单位的 A B C</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="162" />
+            <source>{n} days</source>
+            <translation>{n} 天</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="163" />
+            <source>{n} h</source>
+            <translation>{n} 小时</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="164" />
+            <source>{n} s</source>
+            <translation>{n} 秒</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="165" />
+            <source>none</source>
+            <translation>无</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="166" />
+            <source>The register map matches the register profile: {match} checks matched, {unchecked} not checked.</source>
+            <translation>寄存器映射与寄存器配置一致：{match} 项一致，{unchecked} 项未检查。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/selftest_words.py" line="170" />
+            <source>The register map does not match the register profile: {mismatch} of {total} checks do not match.</source>
+            <translation>寄存器映射与寄存器配置不一致：{total} 项检查中有 {mismatch} 项不一致。</translation>
         </message>
     </context>
     <context>

@@ -24,6 +24,7 @@ from app.link.ops import (
     LinkOp,
     MoveToPoint,
     Pause,
+    ReadRegisters,
     Resume,
     RunProgram,
     SetJogRatio,
@@ -63,6 +64,7 @@ EVERY_OP: tuple[LinkOp, ...] = (
     MoveToPoint(7),
     UploadPoints.of([(7, (400.0, 0.0, 300.0, 180.0, 0.0, 0.0))]),
     CancelUpload(),
+    ReadRegisters(((412, 12), (560, 24))),
 )
 
 
