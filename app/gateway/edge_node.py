@@ -111,6 +111,7 @@ class EdgeNode:
         deadbands: Mapping[str, float] | None = None,
         history_limit: int | None = None,
         primary_host: str | None = None,
+        poll: bool = True,
     ) -> None:
         self.group = group
         self.node = node
@@ -120,7 +121,10 @@ class EdgeNode:
         self._lock = threading.RLock()
         self._devices = {c.name: _Device(c.name, i) for i, c in enumerate(cell.controllers)}
         self._controllers = {c.name: c for c in cell.controllers}
-        self._pollers = {c.name: ControllerPoller(c, self, self.timing) for c in cell.controllers}
+        # poll=False: no pollers of its own, the caller feeds answered() and silent() (the GUI's cell
+        # view, whose pollers already read every controller)
+        self._poll = poll
+        self._pollers = {c.name: ControllerPoller(c, self, self.timing) for c in cell.controllers if poll}
         self._next_index = len(cell.controllers)  # a controller that joins later: aliases never reused
         self.bdseq = 0
         self._seq = 0
@@ -211,7 +215,7 @@ class EdgeNode:
         wanted = {c.name: c for c in cell.controllers}
         with self._lock:
             leaving = [n for n, c in self._controllers.items() if wanted.get(n) != c]
-            stopped = [self._pollers.pop(name) for name in leaving]
+            stopped = [self._pollers.pop(name) for name in leaving if name in self._pollers]
             if leaving:  # their kept changes go with them (no DBIRTH will come before them)
                 topics = {self.topic("DDATA", name) for name in leaving}
                 kept = [(t, m) for t, m in self._history if t not in topics]
@@ -226,12 +230,14 @@ class EdgeNode:
                 self._devices[controller.name] = _Device(controller.name, self._next_index)
                 self._next_index += 1
                 self._controllers[controller.name] = controller
-                self._pollers[controller.name] = ControllerPoller(controller, self, self.timing)
+                if self._poll:
+                    self._pollers[controller.name] = ControllerPoller(controller, self, self.timing)
         for poller in stopped:  # outside the lock: its thread may be waiting for it
             poller.stop()
         if self._running:
             for controller in joining:
-                self._pollers[controller.name].start()
+                if controller.name in self._pollers:
+                    self._pollers[controller.name].start()
         _log.warning("cell changed: %d controller(s) left, %d joined", len(leaving), len(joining))
 
     # -- MQTT callbacks (paho's network thread) -------------------------------------------

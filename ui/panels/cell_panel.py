@@ -41,8 +41,9 @@ from PySide6.QtWidgets import (
 
 from app.cell.cell_file import Cell, CellController
 from app.cell.history import ControllerHistory, alarm_order
+from app.cell.publish import CellPublisher
 from app.gateway.metrics import Reading
-from app.gateway.poller import ControllerPoller, GatewayTiming
+from app.gateway.poller import ControllerPoller, DeviceListener, GatewayTiming
 from app.protocol.enums import (
     ALARM_TEXT,
     CONTROLLER_MODE_TEXT,
@@ -93,16 +94,25 @@ class CellFeed(QObject):
 
 
 class _Listener:
-    """What :class:`ControllerPoller` calls (from its thread)."""
+    """What :class:`ControllerPoller` calls (from its thread): the tiles (queued to the GUI thread)
+    and, while the cell is published, the edge node (in the poller's thread: no network I/O on the
+    GUI's)."""
 
     def __init__(self, feed: CellFeed) -> None:
         self._feed = feed
+        self.publisher: DeviceListener | None = None
 
     def answered(self, device: str, reading: Reading) -> None:
         self._feed.answered_from_poller(device, reading)
+        publisher = self.publisher
+        if publisher is not None:
+            publisher.answered(device, reading)
 
     def silent(self, device: str, reason: str) -> None:
         self._feed.silent_from_poller(device, reason)
+        publisher = self.publisher
+        if publisher is not None:
+            publisher.silent(device, reason)
 
 
 class CellTile(QFrame):
@@ -130,7 +140,7 @@ class CellTile(QFrame):
         self.alarmed = False
         self.stale_after = stale_after
         self.compact = False
-        layout = QVBoxLayout(self)
+        self.body = layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 4, 6, 4)
         layout.setSpacing(1)
         self.name_label = QLabel(self)
@@ -185,7 +195,8 @@ class CellTile(QFrame):
         if compact == self.compact:
             return
         self.compact = compact
-        base = self.parentWidget().font() if self.parentWidget() is not None else QApplication.font()
+        parent = self.parentWidget()
+        base = parent.font() if parent is not None else QApplication.font()
         font = QFont(base)
         font.setPointSizeF(base.pointSizeF() * (COMPACT_FONT_SCALE if compact else 1.0))
         for child in (*self.findChildren(QLabel), self.menu_button):  # each: a style sheet stops inheritance
@@ -195,12 +206,13 @@ class CellTile(QFrame):
         self.name_label.setFont(bold)
         self.menu_button.setFixedHeight(self.name_label.fontMetrics().height())
         # compact: the link state beside the name (one line less), the actions in the menu
-        self.layout().removeWidget(self.link_label)
+        body = self.body
+        body.removeWidget(self.link_label)
         self.head.removeWidget(self.link_label)
         if compact:
             self.head.insertWidget(1, self.link_label, 1)
         else:
-            self.layout().insertWidget(1, self.link_label)
+            body.insertWidget(1, self.link_label)
         self.buttons.setVisible(not compact)
         self.menu_button.setVisible(compact)
         self.name_label.setSizePolicy(
@@ -208,8 +220,8 @@ class CellTile(QFrame):
             QSizePolicy.Policy.Preferred,
         )
         margin = 3 if compact else 6
-        self.layout().setContentsMargins(margin, 1 if compact else 4, margin, 1 if compact else 4)
-        self.layout().setSpacing(0 if compact else 1)
+        body.setContentsMargins(margin, 1 if compact else 4, margin, 1 if compact else 4)
+        body.setSpacing(0 if compact else 1)
         self.head.setSpacing(6 if compact else 2)
         self.retranslate()
 
@@ -275,7 +287,9 @@ class CellTile(QFrame):
             if self.compact
             else self.tr("{age} s ago, RTT {rtt} ms, {errors} errors/min")
         )
-        self.fresh_label.setText(text.format(age=f"{age:.1f}", rtt=f"{self.reading.rtt_ms:.0f}", errors=errors))
+        self.fresh_label.setText(
+            text.format(age=f"{age:.1f}", rtt=f"{self.reading.rtt_ms:.0f}", errors=errors)
+        )
 
     def _show_reading(self) -> None:
         reading = self.reading
@@ -327,7 +341,9 @@ class CellTile(QFrame):
         self.history_button.setText(self.tr("History"))
         self.control_action.setText(self.tr("Take control…"))
         self.history_action.setText(self.tr("History"))
-        self.menu_button.setToolTip(self.tr("Take control or see the history of {name}").format(name=self.name))
+        self.menu_button.setToolTip(
+            self.tr("Take control or see the history of {name}").format(name=self.name)
+        )
         self.name_label.setToolTip(self.where)
         self.refresh()
 
@@ -338,6 +354,7 @@ class CellPanel(QWidget):
     takeControl = Signal(str)
     exportHistory = Signal(str)  # controller name: the host asks where and writes
     ownWindow = Signal(bool)  # the whole-window button: True to leave the tab, False to come back
+    publishAsked = Signal()  # the plant link button: the host asks where to publish
 
     def __init__(
         self,
@@ -363,8 +380,17 @@ class CellPanel(QWidget):
         self.window_button = QPushButton(self)
         self.window_button.setCheckable(True)
         self.window_button.toggled.connect(self.ownWindow)
+        self.publish_label = QLabel(self)
+        self.publish_label.setObjectName("CellPublishState")
+        self.publish_label.setTextFormat(Qt.TextFormat.PlainText)
+        self.publish_button = QPushButton(self)
+        self.publish_button.setObjectName("CellPublishButton")
+        self.publish_button.clicked.connect(self.publishAsked)
+        self.publisher: CellPublisher | None = None
         top = QHBoxLayout()
         top.addWidget(self.title, 1)
+        top.addWidget(self.publish_label)
+        top.addWidget(self.publish_button)
         top.addWidget(self.window_button)
         outer.addLayout(top)
         outer.addWidget(self.pages, 1)
@@ -392,8 +418,8 @@ class CellPanel(QWidget):
         self.pages.addWidget(self.detail)
         self.detail_name: str | None = None
         gateway = timing or GatewayTiming(poll_hz=CELL_POLL_HZ)
-        listener = _Listener(self.feed)
-        self.pollers = [ControllerPoller(c, listener, gateway) for c in cell.controllers]
+        self.listener = _Listener(self.feed)
+        self.pollers = [ControllerPoller(c, self.listener, gateway) for c in cell.controllers]
         self.timer = QTimer(self)
         self.timer.setInterval(250)
         self.timer.timeout.connect(self.refresh)
@@ -505,6 +531,29 @@ class CellPanel(QWidget):
             tile.refresh(self.stale_after)
         if self.pages.currentIndex() == 1:
             self._fill_history()
+        self._show_publishing()
+
+    # --- the plant link ---------------------------------------------------------------
+    def set_publisher(self, publisher: CellPublisher | None) -> None:
+        """Feed ``publisher`` every poll from now on (None: nobody) and say how it is doing."""
+        self.listener.publisher = publisher
+        self.publisher = publisher
+        self._show_publishing()
+
+    def _show_publishing(self) -> None:
+        publisher = self.publisher
+        if publisher is None:
+            self.publish_label.setText("")
+            self.publish_label.setToolTip("")
+            return
+        broker, edge = publisher.broker, publisher.edge
+        where = f"{broker.host}:{broker.port}, spBv1.0/{edge.group}/…/{edge.node}"
+        if publisher.online:  # short: the title row is narrow at 1280×800; the tooltip says where
+            self.publish_label.setText(self.tr("MQTT: published"))
+            self.publish_label.setToolTip(self.tr("Published to {where}").format(where=where))
+        else:
+            self.publish_label.setText(self.tr("MQTT: connecting…"))
+            self.publish_label.setToolTip(self.tr("Connecting to {where}…").format(where=where))
 
     def set_controlled(self, name: str | None) -> None:
         for tile_name, tile in self.tiles.items():
@@ -537,6 +586,11 @@ class CellPanel(QWidget):
         )
         self.back_button.setText(self.tr("Back to the cell"))
         self.window_button.setText(self.tr("Whole window"))
+        self.publish_button.setText(self.tr("Plant link…"))
+        self.publish_button.setToolTip(
+            self.tr("Publish this cell to an MQTT broker (Sparkplug B), as teachpad-gateway")
+        )
+        self._show_publishing()
         self.window_button.setToolTip(self.tr("Show the cell in a window of its own (16 tiles at a glance)"))
         self.export_button.setText(self.tr("Export CSV…"))
         self.table.setHorizontalHeaderLabels([self.tr("Time"), self.tr("Event"), self.tr("Detail")])
