@@ -8,8 +8,8 @@ Run from the repository root (offscreen is enough; a CJK font must be installed)
 
 It starts a fleet of 16 simulators in-process (their programs running), gives a few of them alarms,
 silences one (its tile greys: "not answering N s") and opens the cell in the Cell tab. OUT_DIR gets
-``cell_<lang>_<size>.png`` for both sizes and languages; ``--readme`` writes the 1280×800 ones into
-docs/screenshots/.
+``cell_<lang>_<size>.png`` for both sizes and languages; ``--readme`` writes them into
+docs/screenshots/ (the README shows the 1280×800 ones).
 """
 
 from __future__ import annotations
@@ -70,13 +70,15 @@ def main() -> None:
     _spin(1.0)
     fleet[SILENT].set_silent(True)
     _spin(3.5)
-    sizes = (SIZES[0],) if readme else SIZES
-    for size in sizes:
+    for size in SIZES:
         window.resize(*size)
         for lang in LANGUAGES:
             window.set_language(lang)
             _spin(1.0)
             panel.refresh()
+            for _ in range(3):  # the layout passes the new texts ask for
+                QApplication.sendPostedEvents()
+                QApplication.processEvents()
             window.grab().save(str(out / f"cell_{lang}_{size[0]}x{size[1]}.png"))
     window.close()
     link.shutdown()

@@ -284,7 +284,8 @@ def _says_everything(panel: CellPanel, language: str) -> None:
     assert r1.state_label.text().startswith("自动" if zh else "auto, ")
     assert r1.alarm_label.text() == ("伺服报警" if zh else "servo alarm")
     assert r1.pose_label.text().startswith("X ") and "\nA " in r1.pose_label.text()
-    assert "RTT" in r1.fresh_label.text() and ("err/min" in r1.fresh_label.text())
+    assert ("往返" if zh else "RTT") in r1.fresh_label.text()
+    assert ("/分" if zh else "err/min") in r1.fresh_label.text()
     r6 = panel.tiles["R6"]
     assert r6.silent and r6.property("silent") and not r6.state_label.isEnabled()
     assert r6.link_label.text().startswith("无应答" if zh else "not answering")
