@@ -110,9 +110,11 @@ def test_enabling_births_the_cell_disabling_sends_ndeath_and_disconnects_cleanly
     messages = subscriber.snapshot()
     first = messages.index(nbirth)
     assert all(messages.index(b) > first for b in births.values())
-    assert sorted(b.seq for b in births.values()) == [1, 2, 3]
+    assert sorted(b.seq or 0 for b in births.values()) == [1, 2, 3]
+    reading = panel.tiles["R1"].reading
+    assert reading is not None
     pose_x = births["R1"].metric("Pose/X")
-    assert pose_x.alias and pose_x.double_value == pytest.approx(panel.tiles["R1"].reading.pose.x, abs=50)
+    assert pose_x.alias and pose_x.double_value == pytest.approx(reading.pose.x, abs=50)
     # the Cell tab says so
     qtbot.waitUntil(lambda: panel.publish_label.text() == "MQTT: published", timeout=WAIT_MS)
     assert "pad-gui" in panel.publish_label.toolTip()
