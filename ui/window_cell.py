@@ -20,16 +20,17 @@ from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QEvent, QObject, Qt, Slot
 from PySide6.QtGui import QAction
-from PySide6.QtWidgets import QDialog
 
 from app.errors import TeachPadError
-from app.gateway.poller import GatewayTiming
 from app.link.types import ConnectionState, LinkState
 from app.safety.roles import Action
 
 if TYPE_CHECKING:  # the cell's modules (Modbus clients, pollers) load with the first cell, not at start-up
+    from PySide6.QtWidgets import QDialog
+
     from app.cell.cell_file import Cell
     from app.cell.publish import PublishSettings
+    from app.gateway.poller import GatewayTiming
     from ui.panels.cell_panel import CellPanel
 
 __all__ = ["PUBLISH_KEYS", "CellHost", "install_cell"]
@@ -47,7 +48,7 @@ class CellHost(QObject):
         self.window = window
         self.panel: CellPanel | None = None
         self.controlled: str | None = None
-        self.publish_timing = GatewayTiming()  # the published edge node's clocks (tests: shorter)
+        self.publish_timing: GatewayTiming | None = None  # the edge node's clocks (None: the gateway's)
         self._stopping: list[threading.Thread] = []  # edge nodes saying NDEATH and disconnecting
         self.open_action = QAction(window)
         self.open_action.setObjectName("OpenCellAction")
@@ -223,7 +224,14 @@ class CellHost(QObject):
 
     def run_dialog(self, dialog: QDialog) -> bool:
         """The seam tests answer: show ``dialog`` modally, True when accepted."""
+        from PySide6.QtWidgets import QDialog
+
         return dialog.exec() == QDialog.DialogCode.Accepted
+
+    def _stop_wait(self) -> float:
+        from app import timing
+
+        return self.publish_timing.stop_wait if self.publish_timing is not None else timing.GATEWAY_STOP_WAIT
 
     def _start_publishing(self) -> None:
         from app.cell.publish import CellPublisher
@@ -267,7 +275,7 @@ class CellHost(QObject):
                 self.retranslate()
             elif event.type() == QEvent.Type.Close:
                 self.close_cell()  # the pollers end with the window
-                self.wait_unpublished(self.publish_timing.stop_wait + STOP_SLACK)  # NDEATH before exit
+                self.wait_unpublished(self._stop_wait() + STOP_SLACK)  # NDEATH before exit
         return False
 
 

@@ -805,7 +805,7 @@ The pendant connects to it and commands it; every other robot of the cell stays 
         <message>
             <location filename="../../ui/dialogs/cell_publish_dialog.py" line="88" />
             <source>The broker must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT] (a user name may come before the host, USER@HOST; the password only from {name}).</source>
-            <translation>代理必须是 mqtt://主机[:端口] 或 mqtts://主机[:端口]（主机前可带用户名，USER@HOST；密码只能来自 {name}）。</translation>
+            <translation>代理必须是 mqtt://HOST[:PORT] 或 mqtts://HOST[:PORT]（主机前可带用户名，USER@HOST；密码只能来自 {name}）。</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/cell_publish_dialog.py" line="92" />
