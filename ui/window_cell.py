@@ -10,6 +10,12 @@ connection dialog's), a confirmation naming the robot, one ``link`` audit record
 window's own connect path (:meth:`MainWindow.connect_with`: the link's supervisor decides the
 controller identity, so nothing of one robot's sync state carries to another). Only the window's
 link ever writes; the tiles' clients are monitor-only, so one robot at a time is commandable.
+
+*Plant link…* (the Cell tab's button, :class:`~ui.dialogs.cell_publish_dialog.CellPublishDialog`):
+publish the open cell to an MQTT broker through the gateway's edge node, off by default, remembered
+in the window's settings (:data:`PUBLISH_KEYS`) and applied to every cell opened after. The edge
+node connects in paho's thread and says its NDEATH and disconnects in a thread of its own (the
+window's close waits for it, a bounded time), so the GUI thread never waits on the broker.
 """
 
 from __future__ import annotations

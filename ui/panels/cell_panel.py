@@ -8,6 +8,13 @@ first, then oldest), pose and freshness (age of the last answer, RTT, failed pol
 minute); one that has not answered for :attr:`CellPanel.stale_after` s, or whose last poll
 failed, is greyed and says "not answering N s".
 
+The tiles are full (the address, two buttons) when all of them fit the tab, else compact
+(:meth:`CellPanel.arrange`: a smaller font, the link state beside the name, the actions in a menu,
+shorter words): 16 fit beside the pendant's controls at 1280×800, in both languages.
+
+*Plant link…* publishes the cell through the gateway's edge node
+(:class:`~app.cell.publish.CellPublisher`, set by the host): the pollers feed it from their threads.
+
 Monitor many, command one: the tiles never write (the pollers' clients are monitor-only). *Take
 control* asks the window (:class:`ui.window_cell.CellHost`) to make that robot the pendant's.
 *History* shows the controller's history (:class:`~app.cell.history.ControllerHistory`) in the
