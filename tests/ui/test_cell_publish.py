@@ -13,10 +13,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from PySide6.QtCore import QCoreApplication
 
 from app.cell.publish import PublishSettings
 from app.gateway.poller import GatewayTiming
 from tests.gateway.conftest import Broker, Received, Subscriber, mosquitto_binary
+from tests.ui.layout_audit import clipped_texts
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     app_settings_fixture,
@@ -171,6 +173,14 @@ def test_an_unreachable_broker_costs_the_gui_thread_nothing(
     took = _timed(lambda: window.cell.set_publishing(True, settings))
     assert took < FAST_ENOUGH
     assert panel.publish_label.text() == "MQTT: connecting…"
+    assert "192.0.2.1:1883" in panel.publish_label.toolTip()
+    # the Cell tab's title row still has room for it at 1280×800
+    window.resize(1280, 800)
+    qtbot.waitUntil(lambda: window.size().toTuple() == (1280, 800), timeout=WAIT_MS)
+    for _ in range(3):
+        QCoreApplication.sendPostedEvents()
+        QCoreApplication.processEvents()
+    assert clipped_texts(panel) == []
     # the tiles keep updating meanwhile
     since = time.monotonic()
     qtbot.waitUntil(

@@ -384,6 +384,7 @@ class CellPanel(QWidget):
         outer.setContentsMargins(0, 0, 0, 0)
         self.title = QLabel(self)
         self.title.setTextFormat(Qt.TextFormat.PlainText)
+        self.title.setWordWrap(True)  # a long cell name takes a second line, not the buttons' room
         self.window_button = QPushButton(self)
         self.window_button.setCheckable(True)
         self.window_button.toggled.connect(self.ownWindow)
