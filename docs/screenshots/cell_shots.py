@@ -7,7 +7,8 @@ Run from the repository root (offscreen is enough; a CJK font must be installed)
     QT_QPA_PLATFORM=offscreen .venv/bin/python docs/screenshots/cell_shots.py --readme
 
 It starts a fleet of 16 simulators in-process (their programs running), gives a few of them alarms,
-silences one (its tile greys: "not answering N s") and opens the cell in the Cell tab. OUT_DIR gets
+silences one (its tile greys: "not answering N s"), opens the cell in the Cell tab and publishes it
+(*Plant link…*) to a Mosquitto of its own (``mosquitto`` must be installed). OUT_DIR gets
 ``cell_<lang>_<size>.png`` for both sizes and languages; ``--readme`` writes them into
 docs/screenshots/ (the README shows the 1280×800 ones).
 """
@@ -26,9 +27,11 @@ sys.path.insert(0, str(REPO))
 
 from app import timing  # noqa: E402
 from app.cell.cell_file import Cell, CellController  # noqa: E402
+from app.cell.publish import PublishSettings  # noqa: E402
 from app.link.robot_link import RobotLink  # noqa: E402
 from app.protocol.enums import Alarm  # noqa: E402
 from app.sim.fleet import SimFleet  # noqa: E402
+from benchmarks.gateway import mosquitto  # noqa: E402
 from ui.i18n import Translator  # noqa: E402
 from ui.main_window import MainWindow  # noqa: E402
 from ui.settings import AppSettings  # noqa: E402
@@ -47,6 +50,11 @@ def _spin(seconds: float) -> None:
 
 
 def main() -> None:
+    with mosquitto() as broker_port:
+        shoot(broker_port)
+
+
+def shoot(broker_port: int) -> None:
     readme = "--readme" in sys.argv
     out = REPO / "docs" / "screenshots" if readme else Path(next(a for a in sys.argv[1:] if a != "--readme"))
     out.mkdir(parents=True, exist_ok=True)
@@ -67,6 +75,7 @@ def main() -> None:
         CellController(name=f"R{i + 1}", host="127.0.0.1", port=port) for i, port in enumerate(fleet.ports)
     )
     panel = window.cell.show_cell(Cell("cell 3", controllers))
+    window.cell.set_publishing(True, PublishSettings(f"mqtt://127.0.0.1:{broker_port}", "plant", "pad1"))
     _spin(1.0)
     fleet[SILENT].set_silent(True)
     _spin(3.5)
@@ -80,6 +89,7 @@ def main() -> None:
                 QApplication.sendPostedEvents()
                 QApplication.processEvents()
             window.grab().save(str(out / f"cell_{lang}_{size[0]}x{size[1]}.png"))
+    window.cell.set_publishing(False, PublishSettings(f"mqtt://127.0.0.1:{broker_port}", "plant", "pad1"))
     window.close()
     link.shutdown()
     fleet.stop()
