@@ -146,6 +146,31 @@ GOALS: tuple[tuple[str, float | None, str, str], ...] = (
         " ms",
         "simulator answer p99, one process each (report only)",
     ),
+    # issue 23: the GUI's cell view (benchmarks.cell_view): 16 controllers at 20 Hz, Cell tab at 1280×800
+    (
+        "cell_view.cell_16.gui_thread_cpu_pct_no_probe",
+        15.0,
+        " %",
+        "GUI-thread CPU, cell view of 16 controllers at 20 Hz",
+    ),
+    (
+        "cell_view.cell_16.event_loop.p99_ms",
+        16.0,
+        " ms",
+        "event-loop p99, cell view of 16 controllers at 20 Hz",
+    ),
+    (
+        "cell_view.cell_16.event_loop.gui_thread_cpu_pct",
+        None,
+        " %",
+        "same, GUI-thread CPU with the 1 ms probe running (report only)",
+    ),
+    (
+        "cell_view.cell_16.answers_per_s",
+        None,
+        "/s",
+        "cell view: polls answered per s, all 16 (320 = every poller at 20 Hz; report only)",
+    ),
     ("bundle.size_mb", None, " MB", "the bundle (make dist) on disk (report only)"),
     ("bundle.cli_status_s.ratio_bundle_vs_venv", None, "x", "CLI status run: bundle vs venv (report only)"),
 )

@@ -1,11 +1,13 @@
 """`make bench`: run every benchmark and print one JSON object.
 
-Usage: python -m benchmarks.run [--quick] [--long] [--only core,gui,points,noisy_line,bundle,gateway]
+Usage: python -m benchmarks.run [--quick] [--long] [--only SUITE,...] (default: every suite but safety)
 
 ``goals`` (:mod:`benchmarks.goals`) prints each of the issue's figures beside its goal.
 ``--long`` adds the 10-minute memory soak (``gui.memory.soak``).
 ``gateway`` (:mod:`benchmarks.gateway`): the Sparkplug gateway with 64 simulated controllers at
 10 Hz through a real mosquitto, one dead controller of 16, a bare pymodbus loop beside it.
+``cell_view`` (:mod:`benchmarks.cell_view`): the GUI's Cell tab with 16 simulated controllers at
+20 Hz (GUI-thread CPU, event-loop p99).
 ``bundle`` (:mod:`benchmarks.bundle`): the size and start-up of ``make dist``'s bundle beside the
 venv's; null figures with the reason when it is not built.
 
@@ -82,6 +84,12 @@ def _gateway(args: argparse.Namespace) -> dict[str, Any]:
     return guarded("gateway", lambda: gateway.run(args.quick))
 
 
+def _cell_view(args: argparse.Namespace) -> dict[str, Any]:
+    """The GUI's cell view at scale (issue 23): 16 controllers at 20 Hz in the Cell tab at 1280×800."""
+    cell_view = __import__("benchmarks.cell_view", fromlist=["run"])
+    return guarded("cell_view", lambda: cell_view.run(args.quick))
+
+
 #: The suites in the order they run; each imported only when it runs.
 SUITES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
     "core": _core,
@@ -91,6 +99,7 @@ SUITES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
     "bundle": _bundle,
     "safety": _safety,
     "gateway": _gateway,
+    "cell_view": _cell_view,
 }
 
 
@@ -99,7 +108,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--quick", action="store_true", help="small N and short windows")
     parser.add_argument("--long", action="store_true", help="memory soak of 10 minutes (RSS every 30 s)")
     parser.add_argument(
-        "--only", default="core,gui,points,noisy_line,bundle,gateway", help="comma-separated suites"
+        "--only",
+        default="core,gui,points,noisy_line,bundle,gateway,cell_view",
+        help="comma-separated suites",
     )
     parser.add_argument(
         "--no-compile",

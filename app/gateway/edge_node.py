@@ -146,10 +146,13 @@ class EdgeNode:
         envelope: Envelope | None = None,
         audit_dir: Path | None = None,
         writes: bool = True,
+        poll: bool = True,
     ) -> None:
         """``envelope``: the plant writes' safety envelope (None: the one in force, as the CLI's, read
         when a controller has plant writes); ``audit_dir``: their audit trail (None: TeachPad's);
-        ``writes``: False leaves every robot monitor-only whatever the cell file enables."""
+        ``writes``: False leaves every robot monitor-only whatever the cell file enables;
+        ``poll``: False, no pollers of its own (the caller feeds :meth:`answered` and :meth:`silent`:
+        the GUI's cell view, whose pollers already read every controller) and so no plant writes."""
         self.group = group
         self.node = node
         self.timing = gateway or GatewayTiming()
@@ -158,13 +161,14 @@ class EdgeNode:
         self._lock = threading.RLock()
         self._envelope = envelope
         self._audit_dir = audit_dir
-        self._writes = writes
+        self._writes = writes and poll  # a plant write runs in its robot's poller
         self._pendant_robot: str | None = None
         self._writers: dict[str, PlantWriter] = {}
         self._read_envelope(cell.controllers)
         self._devices = {c.name: self._device(c, i) for i, c in enumerate(cell.controllers)}
         self._controllers = {c.name: c for c in cell.controllers}
-        self._pollers = {c.name: self._poller(c) for c in cell.controllers}
+        self._poll = poll
+        self._pollers = {c.name: self._poller(c) for c in cell.controllers if poll}
         self._next_index = len(cell.controllers)  # a controller that joins later: aliases never reused
         # the last session's bdSeq + 1 when kept in a file (a restart is a new session too), else 0
         self._bdseq_store = None if bdseq_file is None else BdSeqStore(bdseq_file, group, node)
@@ -293,7 +297,7 @@ class EdgeNode:
         wanted = {c.name: c for c in cell.controllers}
         with self._lock:
             leaving = [n for n, c in self._controllers.items() if wanted.get(n) != c]
-            stopped = [self._pollers.pop(name) for name in leaving]
+            stopped = [self._pollers.pop(name) for name in leaving if name in self._pollers]
             if leaving:  # their kept changes go with them (no DBIRTH will come before them)
                 topics = {self.topic("DDATA", name) for name in leaving}
                 kept = [(t, m) for t, m in self._history if t not in topics]
@@ -309,12 +313,14 @@ class EdgeNode:
                 self._devices[controller.name] = self._device(controller, self._next_index)
                 self._next_index += 1
                 self._controllers[controller.name] = controller
-                self._pollers[controller.name] = self._poller(controller)
+                if self._poll:
+                    self._pollers[controller.name] = self._poller(controller)
         for poller in stopped:  # outside the lock: its thread may be waiting for it
             poller.stop()
         if self._running:
             for controller in joining:
-                self._pollers[controller.name].start()
+                if controller.name in self._pollers:
+                    self._pollers[controller.name].start()
         _log.warning("cell changed: %d controller(s) left, %d joined", len(leaving), len(joining))
 
     # -- MQTT callbacks (paho's network thread) -------------------------------------------

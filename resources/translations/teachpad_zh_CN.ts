@@ -623,35 +623,36 @@
     <context>
         <name>CellHost</name>
         <message>
-            <location filename="../../ui/window_cell.py" line="55" />
+            <location filename="../../ui/window_cell.py" line="73" />
             <source>Open cell</source>
+            <extracomment>the window's settings of the plant link: on (off by default), broker URL, group, node</extracomment>
             <translation>打开单元</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="55" />
+            <location filename="../../ui/window_cell.py" line="73" />
             <source>Cell files (*.json);;All files (*)</source>
             <translation>单元文件 (*.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="66" />
+            <location filename="../../ui/window_cell.py" line="84" />
             <source>Cell file</source>
             <translation>单元文件</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="81" />
-            <location filename="../../ui/window_cell.py" line="112" />
-            <location filename="../../ui/window_cell.py" line="179" />
+            <location filename="../../ui/window_cell.py" line="100" />
+            <location filename="../../ui/window_cell.py" line="133" />
+            <location filename="../../ui/window_cell.py" line="275" />
             <source>Cell</source>
             <translation>单元</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="107" />
-            <location filename="../../ui/window_cell.py" line="180" />
+            <location filename="../../ui/window_cell.py" line="128" />
+            <location filename="../../ui/window_cell.py" line="276" />
             <source>Cell {name}</source>
             <translation>单元 {name}</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="139" />
+            <location filename="../../ui/window_cell.py" line="160" />
             <source>Take control of {name} ({where})?
 
 The pendant connects to it and commands it; every other robot of the cell stays monitor-only.</source>
@@ -660,33 +661,33 @@ The pendant connects to it and commands it; every other robot of the cell stays 
 示教器将连接并控制它；单元中其他机器人保持仅监视。</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="142" />
+            <location filename="../../ui/window_cell.py" line="163" />
             <source>Take control</source>
             <translation>接管控制</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="158" />
-            <location filename="../../ui/window_cell.py" line="166" />
+            <location filename="../../ui/window_cell.py" line="179" />
+            <location filename="../../ui/window_cell.py" line="187" />
             <source>Export history</source>
             <translation>导出历史</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="158" />
+            <location filename="../../ui/window_cell.py" line="179" />
             <source>CSV files (*.csv)</source>
             <translation>CSV 文件 (*.csv)</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="167" />
+            <location filename="../../ui/window_cell.py" line="188" />
             <source>Cannot write {path}: {error}</source>
             <translation>无法写入 {path}：{error}</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="174" />
+            <location filename="../../ui/window_cell.py" line="270" />
             <source>Open &amp;cell…</source>
             <translation>打开单元(&amp;C)…</translation>
         </message>
         <message>
-            <location filename="../../ui/window_cell.py" line="175" />
+            <location filename="../../ui/window_cell.py" line="271" />
             <source>Watch every controller of a cell file, monitor only</source>
             <translation>监视单元文件中的每台控制器（仅监视）</translation>
         </message>
@@ -694,100 +695,200 @@ The pendant connects to it and commands it; every other robot of the cell stays 
     <context>
         <name>CellPanel</name>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="397" />
+            <location filename="../../ui/panels/cell_panel.py" line="560" />
+            <source>MQTT: published</source>
+            <translation>MQTT：已发布</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="561" />
+            <source>Published to {where}</source>
+            <translation>已发布到 {where}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="563" />
+            <source>MQTT: connecting…</source>
+            <translation>MQTT：正在连接…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="564" />
+            <source>Connecting to {where}…</source>
+            <translation>正在连接 {where}…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="582" />
             <source>History of {name}</source>
             <translation>{name} 的历史</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="406" />
+            <location filename="../../ui/panels/cell_panel.py" line="591" />
             <source>Cell {name}: {count} controllers, monitor only</source>
             <translation>单元 {name}：{count} 台控制器，仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="410" />
+            <location filename="../../ui/panels/cell_panel.py" line="595" />
             <source>Back to the cell</source>
             <translation>返回单元</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="411" />
+            <location filename="../../ui/panels/cell_panel.py" line="596" />
             <source>Whole window</source>
             <translation>整个窗口</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="412" />
+            <location filename="../../ui/panels/cell_panel.py" line="597" />
+            <source>Plant link…</source>
+            <translation>工厂链路…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="599" />
+            <source>Publish this cell to an MQTT broker (Sparkplug B), as teachpad-gateway</source>
+            <translation>将本单元发布到 MQTT 代理（Sparkplug B），与 teachpad-gateway 相同</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="602" />
             <source>Show the cell in a window of its own (16 tiles at a glance)</source>
             <translation>在单独窗口中显示单元（一眼看到 16 个磁贴）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="413" />
+            <location filename="../../ui/panels/cell_panel.py" line="603" />
             <source>Export CSV…</source>
             <translation>导出 CSV…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="414" />
+            <location filename="../../ui/panels/cell_panel.py" line="604" />
             <source>Time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="414" />
+            <location filename="../../ui/panels/cell_panel.py" line="604" />
             <source>Event</source>
             <translation>事件</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="414" />
+            <location filename="../../ui/panels/cell_panel.py" line="604" />
             <source>Detail</source>
             <translation>详情</translation>
         </message>
     </context>
     <context>
+        <name>CellPublishDialog</name>
+        <message>
+            <location filename="../../ui/dialogs/cell_publish_dialog.py" line="36" />
+            <source>Plant link</source>
+            <translation>工厂链路</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/cell_publish_dialog.py" line="40" />
+            <source>Publish every controller of the cell to an MQTT broker as a Sparkplug B edge node, as teachpad-gateway does (read only: nothing is written to a controller). A broker password comes from the environment variable {name}, never from the settings.</source>
+            <translation>像 teachpad-gateway 一样，将单元中的每台控制器作为 Sparkplug B 边缘节点发布到 MQTT 代理（只读：不向任何控制器写入）。代理密码只来自环境变量 {name}，从不保存在设置中。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/cell_publish_dialog.py" line="48" />
+            <source>Publish this cell</source>
+            <translation>发布本单元</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/cell_publish_dialog.py" line="57" />
+            <source>Broker:</source>
+            <translation>代理：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/cell_publish_dialog.py" line="58" />
+            <source>Group:</source>
+            <translation>组：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/cell_publish_dialog.py" line="59" />
+            <source>Node:</source>
+            <translation>节点：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/cell_publish_dialog.py" line="88" />
+            <source>The broker must be mqtt://HOST[:PORT] or mqtts://HOST[:PORT] (a user name may come before the host, USER@HOST; the password only from {name}).</source>
+            <translation>代理必须是 mqtt://HOST[:PORT] 或 mqtts://HOST[:PORT]（主机前可带用户名，USER@HOST；密码只能来自 {name}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/cell_publish_dialog.py" line="92" />
+            <source>The group and the node must not be empty nor contain '/', '+' or '#'.</source>
+            <translation>组和节点不能为空，也不能包含 '/'、'+' 或 '#'。</translation>
+        </message>
+    </context>
+    <context>
         <name>CellTile</name>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="176" />
+            <location filename="../../ui/panels/cell_panel.py" line="264" />
             <source>{name} (in control)</source>
             <translation>{name}（控制中）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="179" />
+            <location filename="../../ui/panels/cell_panel.py" line="267" />
             <source>not answering {seconds} s</source>
             <translation>无应答 {seconds} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="181" />
+            <location filename="../../ui/panels/cell_panel.py" line="269" />
             <source>answering</source>
             <translation>正在应答</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="185" />
+            <location filename="../../ui/panels/cell_panel.py" line="286" />
+            <source>no answer, {errors} err/min</source>
+            <translation>尚无应答 错误{errors}/分</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="288" />
             <source>no answer yet, {errors} errors/min</source>
             <translation>尚无应答，{errors} 次错误/分钟</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="188" />
+            <location filename="../../ui/panels/cell_panel.py" line="293" />
+            <source>{age} s, RTT {rtt} ms, {errors} err/min</source>
+            <translation>{age}秒 往返{rtt}ms 错误{errors}/分</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="295" />
             <source>{age} s ago, RTT {rtt} ms, {errors} errors/min</source>
             <translation>{age} 秒前，往返 {rtt} 毫秒，{errors} 次错误/分钟</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="219" />
+            <location filename="../../ui/panels/cell_panel.py" line="314" />
             <source>mode {mode}, program {program}</source>
             <translation>模式 {mode}，程序 {program}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="227" />
+            <location filename="../../ui/panels/cell_panel.py" line="314" />
+            <source>{mode}, {program}</source>
+            <translation>{mode}，{program}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="335" />
+            <source>{alarm} +{more}</source>
+            <translation>{alarm} +{more}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="339" />
             <source>alarms: {alarms}</source>
             <translation>报警：{alarms}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="229" />
+            <location filename="../../ui/panels/cell_panel.py" line="352" />
+            <source>Take control or see the history of {name}</source>
+            <translation>接管 {name} 的控制或查看其历史</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/cell_panel.py" line="333" />
             <source>no alarm</source>
             <translation>无报警</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="237" />
+            <location filename="../../ui/panels/cell_panel.py" line="347" />
+            <location filename="../../ui/panels/cell_panel.py" line="349" />
             <source>Take control…</source>
             <translation>接管控制…</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/cell_panel.py" line="238" />
+            <location filename="../../ui/panels/cell_panel.py" line="348" />
+            <location filename="../../ui/panels/cell_panel.py" line="350" />
             <source>History</source>
             <translation>历史</translation>
         </message>
@@ -1669,12 +1770,12 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="179" />
+            <location filename="../../ui/window_column.py" line="183" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="183" />
+            <location filename="../../ui/window_column.py" line="187" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>

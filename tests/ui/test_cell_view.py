@@ -80,7 +80,9 @@ def sims_fixture(sim_factory: Any) -> list[Any]:
 
 
 @pytest.fixture(name="panel")
-def panel_fixture(window: Any, project_dialogs: Any, sims: list[Any], tmp_path: Path) -> Any:
+def panel_fixture(qtbot: Any, window: Any, project_dialogs: Any, sims: list[Any], tmp_path: Path) -> Any:
+    window.resize(1920, 1080)  # room for full tiles
+    qtbot.waitUntil(lambda: window.size().toTuple() == (1920, 1080), timeout=WAIT_MS)
     panel = _open(window, project_dialogs, _cell(sims, tmp_path))
     yield panel
     window.cell.close_cell()
@@ -93,6 +95,8 @@ def test_open_cell_shows_a_tile_per_controller_each_with_its_own_poller(
     assert list(panel.tiles) == ["R1", "R2", "R3"]
     qtbot.waitUntil(lambda: all(_answering(t) for t in panel.tiles.values()), timeout=WAIT_MS)
     tile = panel.tiles["R1"]
+    assert not panel.compact and tile.control_button.isVisible()  # room enough: full tiles
+    assert tile.name_label.text() == f"R1  {tile.where}"
     assert tile.link_label.text() == "answering"
     assert tile.state_label.text().startswith("mode ")
     assert tile.alarm_label.text() == "no alarm"
@@ -259,6 +263,40 @@ def test_a_bad_cell_file_is_one_line_in_a_dialog(
     assert "R2" in text and "port" in text and "\n" not in text
 
 
+def _all_in_sight(qtbot: Any, panel: CellPanel) -> None:
+    bars = (panel.area.verticalScrollBar(), panel.area.horizontalScrollBar())
+    qtbot.waitUntil(lambda: all(bar.maximum() == 0 for bar in bars), timeout=WAIT_MS)  # layout passes
+    grid_host = panel.area.widget()
+    assert grid_host is not None and overlapping_siblings(grid_host) == []
+    view = panel.area.viewport()
+    for tile in panel.tiles.values():
+        corner = tile.mapTo(view, tile.rect().bottomRight())
+        assert view.rect().contains(corner), f"{tile.name} is out of sight"
+
+
+def _says_everything(panel: CellPanel, language: str) -> None:
+    """Name, link state, mode and program, alarms (most severe first), pose, freshness; the silent
+    one greyed and saying so."""
+    zh = language != "en"
+    r1 = panel.tiles["R1"]
+    assert r1.name_label.text() == "R1" and r1.name_label.toolTip() == r1.where
+    assert r1.link_label.text() == ("正在应答" if zh else "answering")
+    assert r1.state_label.text().startswith("自动" if zh else "auto, ")
+    assert r1.alarm_label.text() == ("伺服报警" if zh else "servo alarm")
+    assert r1.pose_label.text().startswith("X ") and "\nA " in r1.pose_label.text()
+    assert ("往返" if zh else "RTT") in r1.fresh_label.text()
+    assert ("/分" if zh else "err/min") in r1.fresh_label.text()
+    r6 = panel.tiles["R6"]
+    assert r6.silent and r6.property("silent") and not r6.state_label.isEnabled()
+    assert r6.link_label.text().startswith("无应答" if zh else "not answering")
+    # the actions are in the tile's menu
+    assert r1.menu_button.isVisible() and not r1.control_button.isVisible()
+    assert [a.text() for a in r1.menu_button.menu().actions()] == [
+        r1.control_button.text(),
+        r1.history_button.text(),
+    ]
+
+
 @pytest.mark.qt_log_ignore(
     *QT_LOG_IGNORE, "This plugin does not support setParent"
 )  # offscreen's, going back
@@ -285,27 +323,24 @@ def test_sixteen_tiles_fit_1280x800(
     try:
         qtbot.waitUntil(lambda: sum(_answering(t) for t in panel.tiles.values()) == 15, timeout=WAIT_MS * 2)
         qtbot.waitUntil(lambda: panel.tiles["R6"].silent, timeout=WAIT_MS)
-        # in the tab beside the pendant's controls: reflowed to its width, nothing cut, no overlap
+        # in the tab beside the pendant's controls (the normal layout): compact tiles, all 16 in sight
+        # without scrolling, every field said, nothing cut, no overlap
         panel.refresh()
         _laid_out()
+        assert panel.compact and panel.columns == 4
+        _all_in_sight(qtbot, panel)
         assert clipped_texts(panel) == []
         assert overlapping_siblings(panel) == []
+        _says_everything(panel, language)
         # in a window of its own at 1280×800: all 16 at a glance
         panel.window_button.click()
         assert panel.isWindow() and panel.size().toTuple() == (1280, 800)
         qtbot.waitExposed(panel)
         panel.refresh()
         _laid_out()
-        bars = (panel.area.verticalScrollBar(), panel.area.horizontalScrollBar())
-        qtbot.waitUntil(lambda: all(bar.maximum() == 0 for bar in bars), timeout=WAIT_MS)  # layout passes
+        _all_in_sight(qtbot, panel)
         assert clipped_texts(panel) == []
         assert overlapping_siblings(panel) == []
-        grid_host = panel.area.widget()
-        assert grid_host is not None and overlapping_siblings(grid_host) == []
-        view = panel.area.viewport()
-        for tile in panel.tiles.values():
-            corner = tile.mapTo(view, tile.rect().bottomRight())
-            assert view.rect().contains(corner), f"{tile.name} is out of sight"
         assert (
             panel.tiles["R6"].link_label.text().startswith("not answering" if language == "en" else "无应答")
         )
