@@ -128,6 +128,42 @@ def test_the_points_sent_around_a_restart_go_again_through_the_upload_driver(
     assert set(suspects) - {12} <= set(held) and 12 not in held
 
 
+def _repairing(sim: Any) -> bool:
+    """The points sent around a restart are being created again: a create point went out after
+    the repair's fresh token (the run's second write of the canary: the first armed the boot)."""
+    canary = 2 * CANARY_GV
+    tokens = [i for i, w in enumerate(list(sim.writes)) if w.address <= canary < w.address + len(w.values)]
+    return len(tokens) >= 2 and bool(_creates(sim, tokens[1]))
+
+
+def test_ctrl_c_while_the_points_sent_around_a_restart_go_again(
+    sim_factory: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """Ctrl-C while the points sent around a restart are created again is the upload driver's
+    Ctrl-C, as in any upload: what was done is kept and said -- the restart, the points created
+    again before it -- the upload record of the old boot is void, exit 130. (The CLI's own repair
+    let the KeyboardInterrupt out: a bare "interrupted", the restart unsaid.)"""
+    sim = sim_factory(command_latency=0.3)  # each point a while: Ctrl-C lands during the repair
+    project = _project(sim, capsys, tmp_path)
+    sim.restart_after_write(2 * stage_gv_for(CANARY_GV), 5)  # as above: P10's staged pose is wiped
+    code, err = interrupt_cli(sim, ["points", "upload", str(project)], lambda _s: _repairing(sim))
+    assert code == ExitCode.INTERRUPTED, err
+    assert "the controller restarted during the upload" in err, err
+    found = re.search(
+        r"; ((?:P\d+,)*P\d+), sent around it, were created again after it: ((?:P\d+,)*P\d+|none) "
+        r"\(interrupted; the others may be at wrong poses on the controller\)",
+        err,
+    )
+    assert found is not None and "Traceback" not in err, err
+    suspects, again = (set(re.findall(r"P(\d+)", group)) for group in found.groups())
+    assert again <= suspects, (again, suspects)
+    # at the simulator: a point at a wrong pose (the wiped one) is one the CLI did not say it made again
+    wrong = {str(i) for i, pose in sim.state().points.items() if pose != pytest.approx(_pose(i))}
+    assert wrong <= suspects - again, (wrong, suspects, again)
+    record = load_record(record_path(project))
+    assert record is not None and record.points == {} and record.identity.boot is None  # void
+
+
 def test_an_interrupted_upload_resumes_from_its_record_and_another_boot_sends_all(
     sim_factory: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path
 ) -> None:
