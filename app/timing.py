@@ -94,7 +94,7 @@ TEACH_IDLE_DISABLE = 30.0  # s after the last jog release before teach mode is d
 TEACH_MODE_GRACE = 0.3  # s after teach enable during which a status without mode 2 is not "teach lost"
 UPLOAD_CHUNK_POINTS = 20  # points per event-loop turn of an upload, at most ...
 UPLOAD_CHUNK_SECONDS = 0.03  # ... or this long (s), whichever comes first
-UPLOAD_PROGRESS_PERIOD = 0.05  # s between uploadProgress emissions (the last one always goes out)
+UPLOAD_PROGRESS_PERIOD = 0.05  # s between an upload's UploadProgress reports (the last one always goes out)
 UPLOAD_RECORD_PERIOD = 1.0  # s between two writes of teachpad-cli's upload record during an upload
 SHUTDOWN_WAIT = 1.5  # s the GUI waits for the worker thread on shutdown before detaching it
 

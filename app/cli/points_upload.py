@@ -21,7 +21,6 @@ point at the same pose: safe to repeat) and proven by a fresh token, and the res
 
 from __future__ import annotations
 
-import itertools
 import random
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, replace
@@ -35,12 +34,13 @@ from app.models import CommandResult
 from app.points.point import TempPoint
 from app.points.upload import BootLost, UploadOutcome, UploadReport
 from app.points.upload_record import UploadRecord
-from app.protocol.registers import CANARY_GV, UPLOAD_POSE_GV
+from app.protocol.registers import CANARY_GV
 
 __all__ = ["CANARY_EVERY", "BootWatch", "open_boot", "staged_upload"]
 
 #: points created between two reads of the restart canary during an upload (and one after the last)
 CANARY_EVERY = 8
+CHANGED_AGAIN = "the restart canary changed again while they were created"
 
 
 class CanaryClient(Protocol):
@@ -187,7 +187,10 @@ class _StagedUpload:
             report.aborted = report.aborted or self.why_stopped()
             suspects = self.ordered[self.proven : self.done]
             after = self.ordered[self.proven - 1].id if self.proven else None
-            report.boot_lost = _repair(self.client, self.watch, BootLost(self.changed, after), suspects)
+            report.boot_lost, interrupted = _repair(
+                self.client, self.watch, BootLost(self.changed, after), suspects
+            )
+            report.interrupted = report.interrupted or interrupted
         return report
 
     def run(self) -> UploadReport:
@@ -241,35 +244,37 @@ class _StagedUpload:
         return None
 
 
-def _repair(client: Any, watch: BootWatch, lost: BootLost, suspects: Sequence[TempPoint]) -> BootLost:
+def _repair(
+    client: Any, watch: BootWatch, lost: BootLost, suspects: Sequence[TempPoint]
+) -> tuple[BootLost, bool]:
     """After the canary changed: create the points tried since its last good read again, at their
     poses, on the new boot (a restart may have wiped a staged pose: that point is at zeros), and
-    prove them with a token of this boot (a fresh one after a restart, else the value now there)."""
+    prove them with a token of this boot (a fresh one after a restart, else the value now there).
+    They go the way every upload goes (:func:`staged_upload`, the one upload driver's batches: per
+    tool frame, a refused point that point's only, a lost link or Ctrl-C the end); the second
+    value is True when Ctrl-C ended it."""
     lost = replace(lost, suspects=tuple(p.id for p in suspects))
     if not suspects:
-        return lost
+        return lost, False
     token = lost.value
-    repaired: list[int] = []
     client.invalidate_cache()  # GV245 (the tool frame) was cleared with the rest: written anew
     try:
         if token == 0.0:
             token = new_token()
             client.write_gv(watch.gv, [token])
-        for group in _tool_groups(suspects):
-            results = client.upload_points(
-                [(p.id, p.xyzabc) for p in group], group[0].tool, gv_start=UPLOAD_POSE_GV
-            )
-            repaired += [p.id for p, r in zip(group, results, strict=False) if r.ok and not r.unconfirmed]
-        if watch.read(client) != token:
-            return replace(lost, repair_error="the restart canary changed again while they were created")
+        again = _StagedUpload(client, group_by_tool(suspects, _tool), None, None).run()
     except TeachPadError as exc:
-        return replace(lost, repaired=tuple(repaired), repair_error=str(exc))
+        return replace(lost, repair_error=str(exc)), False
+    repaired = tuple(o.point_id for o in again.outcomes if o.ok and not o.unconfirmed)
+    if again.aborted is not None:  # the link failed, Ctrl-C: the rest not created again
+        return replace(lost, repaired=repaired, repair_error=again.aborted), again.interrupted
+    try:
+        if watch.read(client) != token:
+            return replace(lost, repair_error=CHANGED_AGAIN), False
+    except TeachPadError as exc:
+        return replace(lost, repaired=repaired, repair_error=str(exc)), False
     missing = len(suspects) - len(repaired)
-    return replace(lost, repaired=tuple(repaired), repair_error=f"{missing} refused" if missing else "")
-
-
-def _tool_groups(points: Sequence[TempPoint]) -> list[list[TempPoint]]:
-    return [list(group) for _, group in itertools.groupby(group_by_tool(points, _tool), key=_tool)]
+    return replace(lost, repaired=repaired, repair_error=f"{missing} refused" if missing else ""), False
 
 
 def _record(report: UploadReport, batch: Sequence[TempPoint], results: Sequence[CommandResult]) -> str | None:

@@ -15,6 +15,7 @@ from app.models import CommandResult, ControllerStatus, Pose
 
 if TYPE_CHECKING:
     from app.link.client import RobotClient
+    from app.link.progress import Progress
     from app.link.stats import LinkStats
     from app.link.transport import TrafficRecord
     from app.safety.audit import AuditLog
@@ -51,9 +52,8 @@ class WorkerOutputs(Protocol):
     def publish_foreign_master(self, what: str, value: float) -> None:
         """Another master was seen (app/link/foreign.py): ``what`` ("gv291", "canary"), the value."""
 
-    def publish_upload_progress(self, done: int, total: int) -> None: ...
-    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
-        """``unconfirmed``: ok, but the controller's status never changed (observe rule)."""
+    def publish_progress(self, ticket: int | None, progress: Progress) -> None:
+        """A request's progress (an upload's points and count), keyed by its ticket."""
 
     def publish_guard_stop(self, violation: EnvelopeViolation) -> None: ...
     def publish_halt(self, halt: UnconfirmedHalt | None) -> None:

@@ -1,6 +1,6 @@
 """What panels and controllers hold of the link: :class:`LinkPort`, the typed port RobotLink
-fits (and the tests' small fake), :class:`Pending`, one request's outcome, and
-:class:`RequestRouter`, request id -> Pending."""
+fits (and the tests' small fake), :class:`Pending`, one request's progress and outcome, and
+:class:`RequestRouter`, request id (ticket) -> Pending."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ from typing import Protocol
 from PySide6.QtCore import QMetaMethod, QObject, QTimer, Signal, SignalInstance
 
 from app.link.ops import LinkOp
+from app.link.progress import Progress
 from app.link.state import RobotState
 from app.link.types import WorkerError
 from app.models import CommandResult
@@ -17,14 +18,17 @@ __all__ = ["LinkPort", "Pending", "RequestRouter"]
 
 
 class Pending(QObject):
-    """One request's outcome: exactly one of ``finished`` / ``failed`` fires, once; then every
-    receiver is disconnected (connect before the outcome: call ``track`` right away).
+    """One request's progress and outcome: ``progressed`` (a :mod:`~app.link.progress` report:
+    an upload's points and count) for this request only, any number of times, before its
+    outcome; exactly one of ``finished`` / ``failed`` fires, once; then every receiver is
+    disconnected (connect before the outcome: call ``track`` right away).
 
     Why the disconnect: a receiver that captures its Pending (``pending.finished.connect(lambda r:
     self._on_result(pending, r))``, the controllers' way) makes a cycle that runs through Qt's
     connection, which the garbage collector cannot see: every such Pending (and what its lambdas
     captured) lived as long as the process, a leak per request (issue 18)."""
 
+    progressed = Signal(object)  # Progress (app/link/progress.py) of this request
     finished = Signal(CommandResult)
     failed = Signal(WorkerError)
 
@@ -41,6 +45,10 @@ class Pending(QObject):
     @property
     def done(self) -> bool:
         return self.result is not None or self.error is not None
+
+    def _progress(self, progress: Progress) -> None:
+        if not self.done:
+            self.progressed.emit(progress)
 
     def _finish(self, result: CommandResult) -> None:
         if not self.done:
@@ -67,7 +75,8 @@ class Pending(QObject):
 
 
 class RequestRouter:
-    """Request id -> :class:`Pending`; the outcomes of untracked requests are ignored here."""
+    """Request id -> :class:`Pending`; the progress and outcomes of untracked requests are
+    ignored here."""
 
     def __init__(self) -> None:
         self._pending: dict[int, Pending] = {}
@@ -84,6 +93,10 @@ class RequestRouter:
             self._pending[request_id] = pending
         return pending
 
+    def on_progress(self, ticket: int, progress: Progress) -> None:
+        if pending := self._pending.get(ticket):
+            pending._progress(progress)
+
     def on_result(self, result: CommandResult) -> None:
         if result.request_id is not None and (pending := self._pending.pop(result.request_id, None)):
             pending._finish(result)
@@ -99,15 +112,15 @@ class RequestRouter:
 class LinkPort(Protocol):
     """What panels and controllers use of the link (RobotLink fits; the tests' FakeLink too):
     its state (``state.stops_requested`` included), ``submit(op)`` of one operation of
-    :mod:`app.link.ops` (its ticket back: the request id) and ``track(ticket)``; besides, the
-    signals that are not one request's outcome (the link came back, the controller restarted,
-    another master, an upload's points and progress)."""
+    :mod:`app.link.ops` (its ticket back: the request id) and ``track(ticket)`` (that request's
+    progress and outcome); besides, every request's progress keyed by its ticket
+    (``progressed``) and the signals that are not one request's (the link came back, the
+    controller restarted, another master)."""
 
     controllerReconnected: SignalInstance  # noqa: N815 - () the link came back: the worker made it safe
     controllerRestarted: SignalInstance  # noqa: N815 - () the restart canary changed: temp points are gone
     foreignMaster: SignalInstance  # noqa: N815 - (str, float) another master seen: what, the value (app/link/foreign.py)
-    uploadProgress: SignalInstance  # noqa: N815 - (int, int) points done, total of the running upload
-    pointUploaded: SignalInstance  # noqa: N815 - (int, bool, str, bool) point id, ok, reason, unconfirmed
+    progressed: SignalInstance  # (int, Progress) a request's ticket, its progress (app/link/progress.py)
 
     @property
     def state(self) -> RobotState: ...

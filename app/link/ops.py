@@ -232,9 +232,10 @@ class MoveToPoint(LinkOp):
 @dataclass(frozen=True)
 class UploadPoints(LinkOp):
     """Create many temp points, grouped by tool (GV245 once per tool), in chunks; each point is
-    reported by ``pointUploaded``, the batch by one result. Stop or :class:`CancelUpload` end it
-    between two points. ``items`` are (id, pose6, tool), copied here and checked in the worker
-    before the first write; :meth:`of` also takes (id, pose6) items with one tool for them all."""
+    reported under its ticket (:mod:`app.link.progress`), the batch by one result. Stop or
+    :class:`CancelUpload` end it between two points. ``items`` are (id, pose6, tool), copied here
+    and checked in the worker before the first write; :meth:`of` also takes (id, pose6) items with
+    one tool for them all."""
 
     operation: ClassVar[str] = Operation.UPLOAD_POINTS
     kind: ClassVar[JobKind] = JobKind.MOTION

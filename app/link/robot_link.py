@@ -3,9 +3,11 @@
 Besides the worker's signals (re-exposed for logs, benchmarks and tests) the link holds the
 GUI side's one picture of the robot, :class:`~app.link.state.RobotState` (``link.state``), and
 matches request ids in one place: ``link.track(link.submit(MoveToPoint(...)))`` gives a
-:class:`Pending` whose ``finished(CommandResult)`` / ``failed(WorkerError)`` fire only for that
-request. :class:`LinkPort` is the typed port that panels and controllers use (RobotLink fits;
-tests use a small fake that fits too).
+:class:`Pending` whose ``progressed(Progress)``, ``finished(CommandResult)`` and
+``failed(WorkerError)`` fire only for that request. Every request's progress also goes out on
+``progressed(ticket, Progress)`` (:mod:`app.link.progress`: an upload's points and count), keyed
+by the ticket ``submit`` returned. :class:`LinkPort` is the typed port that panels and
+controllers use (RobotLink fits; tests use a small fake that fits too).
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ from app.connection import ConnectionSettings
 from app.errors import Reason
 from app.link.link_port import Pending, RequestRouter
 from app.link.ops import LinkOp, Stop
+from app.link.progress import Progress
 from app.link.state import DEFAULT_FRESHNESS_LIMIT, PollUpdate, RobotState
 from app.link.stats import LinkStats
 from app.link.types import ConnectionState, LinkState, WorkerError
@@ -65,8 +68,7 @@ class RobotLink(QObject):
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815
     foreignMaster = Signal(str, float)  # noqa: N815
-    uploadProgress = Signal(int, int)  # noqa: N815
-    pointUploaded = Signal(int, bool, str, bool)  # noqa: N815
+    progressed = Signal(int, object)  # ticket, Progress (app/link/progress.py): a request's progress
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard stopped a jog
     registersRead = Signal(object)  # noqa: N815 - RegisterBlocks of a ReadRegisters op (its request_id)
 
@@ -154,8 +156,7 @@ class RobotLink(QObject):
             (w.controllerReconnected, self.controllerReconnected),
             (w.controllerRestarted, self.controllerRestarted),
             (w.foreignMaster, self.foreignMaster),
-            (w.uploadProgress, self.uploadProgress),
-            (w.pointUploaded, self.pointUploaded),
+            (w.progressed, self._on_progress),
             (w.jogGuardStopped, self.jogGuardStopped),
             (w.registersRead, self.registersRead),
             (w.haltChanged, state.set_halt),
@@ -244,6 +245,11 @@ class RobotLink(QObject):
             LinkState.DISCONNECTED, "the link was shut down", endpoint, reason=Reason("link_was_shut_down")
         )
         self._state.set_connection(shut)
+
+    @Slot(int, object)
+    def _on_progress(self, ticket: int, progress: Progress) -> None:
+        self._router.on_progress(ticket, progress)
+        self.progressed.emit(ticket, progress)
 
     @Slot(CommandResult)
     def _on_result(self, result: CommandResult) -> None:

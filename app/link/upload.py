@@ -27,7 +27,8 @@ words and counted as refused or failed; the next chunk goes on with the next poi
 
 The per-batch sending and the reading of each point's result are the one upload driver's
 (:mod:`app.link.upload_driver`), shared with the CLI; this module is the worker's reporting around
-it (chunks, urgent jobs between points, ``pointUploaded``, ``uploadProgress``, the final result).
+it (chunks, urgent jobs between points, its progress -- each point, the count -- under the
+upload's ticket, the final result).
 """
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ from app import timing
 from app.errors import InvalidInput, LinkError, TeachPadError, WriteBlocked
 from app.link.client import RobotClient
 from app.link.host import WorkerHost
+from app.link.progress import PointUploaded, UploadProgress
 from app.link.types import Operation
 from app.link.upload_driver import UploadCounts, Verdict, batch_end, group_by_tool, send_batch
 from app.models import CommandResult
@@ -69,7 +71,7 @@ class WorkerUpload:
     items: list[UploadItem]  # grouped by tool frame: GV245 is written once per group
     index: int = 0  # items attempted so far
     end: str | None = None  # why it ends early ("cancelled", "stopped", "link lost: ..."), once set
-    progress_at: float = 0.0  # when uploadProgress was last emitted
+    progress_at: float = 0.0  # when its UploadProgress was last published
     progress_done: int = -1  # the ``done`` it carried
     halts_at_start: int = 0  # the host's count of stops and cancels requested when it began
     #: created, refused (a refused status, a Modbus exception) and failed (no acknowledgement,
@@ -229,9 +231,10 @@ class Uploader:
             upload.index += 1
             seen = upload.tally.count(result)
             if seen is Verdict.CREATED:
-                host.publish_point_uploaded(point_id, True, "", result.unconfirmed)
-                continue
-            host.publish_point_uploaded(point_id, False, result.message or "failed")
+                point = PointUploaded(point_id, True, "", result.unconfirmed)
+            else:
+                point = PointUploaded(point_id, False, result.message or "failed")
+            host.publish_progress(upload.request_id, point)
             if seen is Verdict.LINK_FAILED:  # its outcome is unknown, the link not to be trusted
                 transport_error = result.message
         return transport_error
@@ -246,7 +249,7 @@ class Uploader:
         if upload.index != upload.progress_done and due:
             upload.progress_at = now
             upload.progress_done = upload.index
-            self._host.publish_upload_progress(upload.index, len(upload.items))
+            self._host.publish_progress(upload.request_id, UploadProgress(upload.index, len(upload.items)))
 
     def end(self, reason: str) -> None:
         """Ask the running upload to end before its next point (at once when between chunks)."""
@@ -259,7 +262,7 @@ class Uploader:
             self.finish()
 
     def finish(self) -> None:
-        """The batch's final commandFinished (after every pointUploaded), with the upload's request id."""
+        """The batch's final commandFinished (after every PointUploaded), with the upload's request id."""
         upload, self.run = self.run, None
         if upload is None:
             return

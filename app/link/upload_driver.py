@@ -2,9 +2,9 @@
 
 Both uploads -- the GUI's (:class:`app.link.upload.Uploader`, run in chunks by the worker) and
 ``teachpad-cli points upload`` (:func:`app.cli.points_upload.staged_upload`) -- send their points
-through this module, and only their reporting differs (the worker publishes ``pointUploaded`` and
-one final result; the CLI builds an :class:`app.points.upload.UploadReport` and watches the restart
-canary between points):
+through this module, and only their reporting differs (the worker publishes each point and the
+count under the upload's ticket, :mod:`app.link.progress`, and one final result; the CLI builds an
+:class:`app.points.upload.UploadReport` and watches the restart canary between points):
 
 * :func:`group_by_tool`: the order (GV245, the tool frame, written once per tool);
 * :func:`batch_end`: where a batch of one tool frame ends (the worker's chunks are also bounded);

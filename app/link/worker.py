@@ -18,8 +18,9 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
   commands, started without waiting, and the completion of the one under way (one motion at a
   time; Stop clears it). A create point while another short command is tracked waits in
   ``_held`` until that one's outcome is known (GV291 tells one command at a time).
-* :class:`~app.link.upload.Uploader` -- chunked upload of many points, ``pointUploaded`` per
-  point, ``uploadProgress``, one final ``commandFinished``; ``cancel_upload`` or a stop end it.
+* :class:`~app.link.upload.Uploader` -- chunked upload of many points, its progress
+  (``progressed``, keyed by the upload's ticket: :mod:`app.link.progress`) per point and
+  overall, one final ``commandFinished``; ``cancel_upload`` or a stop end it.
 * :class:`~app.link.capture.TrafficCapture`, RTT and link statistics. The captured frames go
   out in batches (``trafficObserved``) every :data:`app.timing.TRAFFIC_DELIVERY_PERIOD` from the
   worker's own timer, not once per poll (one queued call into the GUI thread instead of ten at
@@ -80,6 +81,7 @@ from app.link.jog import JogMachine, PreemptedError
 from app.link.motion import MotionCommands
 from app.link.ops import CancelUpload, Handlers, LinkOp, Stop
 from app.link.poller import Poller
+from app.link.progress import Progress
 from app.link.register_reads import RegisterBlocks, RegisterReads
 from app.link.sequence import poll
 from app.link.state import PollUpdate
@@ -125,8 +127,7 @@ class RobotWorker(QObject):
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815 - the canary GV changed while the link stayed up
     foreignMaster = Signal(str, float)  # noqa: N815 - another master seen: what ("gv291", "canary"), the value
-    uploadProgress = Signal(int, int)  # noqa: N815 - points done, total
-    pointUploaded = Signal(int, bool, str, bool)  # noqa: N815 - point id, ok, reason ("" when ok), unconfirmed
+    progressed = Signal(int, object)  # ticket (request id), Progress (app/link/progress.py): an upload's
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard wrote ratio 0
     haltChanged = Signal(object)  # noqa: N815 - UnconfirmedHalt | None: a stop the controller has not confirmed
     registersRead = Signal(object)  # noqa: N815 - RegisterBlocks: what a ReadRegisters op read
@@ -409,11 +410,8 @@ class RobotWorker(QObject):
     def publish_foreign_master(self, what: str, value: float) -> None:
         self.foreignMaster.emit(what, value)
 
-    def publish_upload_progress(self, done: int, total: int) -> None:
-        self.uploadProgress.emit(done, total)
-
-    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
-        self.pointUploaded.emit(point_id, ok, reason, unconfirmed)
+    def publish_progress(self, ticket: int | None, progress: Progress) -> None:
+        self.progressed.emit(0 if ticket is None else ticket, progress)
 
     def publish_guard_stop(self, violation: EnvelopeViolation) -> None:
         self.jogGuardStopped.emit(violation)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -96,6 +97,71 @@ def test_a_restart_mid_upload_reads_as_a_restart_and_leaves_no_zero_point(
     assert sorted(_creates(sim, since)) == list(range(1, N + 1))
     assert "already on the controller" not in out
     assert sorted(_held_right(sim)) == list(range(1, N + 1))
+
+
+def test_the_points_sent_around_a_restart_go_again_through_the_upload_driver(
+    sim_factory: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """The points sent around a restart are created again the way every upload goes (the one
+    upload driver, :mod:`app.link.upload_driver`): a point the controller refuses is that point's
+    only, the next ones of its tool frame still go out on the new boot. (The CLI's own repair sent
+    each tool frame in one call: after P12's refusal the rest of the frame was never created
+    again, and the CLI counted them all "refused".) Seen at the simulator: the create points after
+    the repair's fresh token."""
+    sim = sim_factory(command_latency=0.02)  # the controller works a while: the poses are staged
+    project = _project(sim, capsys, tmp_path)
+    sim.restart_after_write(2 * stage_gv_for(CANARY_GV), 5)  # as above: P10's staged pose is wiped
+    sim.refuse_point_write(12, times=1000)  # the controller refuses P12, in the upload and again after
+    code, out, err = run(sim, capsys, "--timeout", "1", "points", "upload", str(project))
+    assert code == ExitCode.FAILED, (out, err)
+    assert "the controller restarted during the upload" in err, err
+    found = re.search(r"; ((?:P\d+,)*P\d+), sent around it, were created again after it: ", err)
+    assert found is not None, err
+    suspects = [int(p[1:]) for p in found.group(1).split(",")]
+    assert 12 in suspects and suspects[-1] > 12, suspects  # P12 refused with others after it
+    assert "(1 refused; the others may be at wrong poses on the controller)" in err, err
+    canary = 2 * CANARY_GV  # the repair's fresh token for the new boot: its last write
+    fresh = max(i for i, w in enumerate(sim.writes) if w.address <= canary < w.address + len(w.values))
+    again = _creates(sim, fresh)
+    assert again == [p for p in suspects if p != 12], (again, suspects)  # in order, each once
+    held = _held_right(sim)
+    assert set(suspects) - {12} <= set(held) and 12 not in held
+
+
+def _repairing(sim: Any) -> bool:
+    """The points sent around a restart are being created again: a create point went out after
+    the repair's fresh token (the run's second write of the canary: the first armed the boot)."""
+    canary = 2 * CANARY_GV
+    tokens = [i for i, w in enumerate(list(sim.writes)) if w.address <= canary < w.address + len(w.values)]
+    return len(tokens) >= 2 and bool(_creates(sim, tokens[1]))
+
+
+def test_ctrl_c_while_the_points_sent_around_a_restart_go_again(
+    sim_factory: Any, capsys: pytest.CaptureFixture[str], tmp_path: Path
+) -> None:
+    """Ctrl-C while the points sent around a restart are created again is the upload driver's
+    Ctrl-C, as in any upload: what was done is kept and said -- the restart, the points created
+    again before it -- the upload record of the old boot is void, exit 130. (The CLI's own repair
+    let the KeyboardInterrupt out: a bare "interrupted", the restart unsaid.)"""
+    sim = sim_factory(command_latency=0.3)  # each point a while: Ctrl-C lands during the repair
+    project = _project(sim, capsys, tmp_path)
+    sim.restart_after_write(2 * stage_gv_for(CANARY_GV), 5)  # as above: P10's staged pose is wiped
+    code, err = interrupt_cli(sim, ["points", "upload", str(project)], lambda _s: _repairing(sim))
+    assert code == ExitCode.INTERRUPTED, err
+    assert "the controller restarted during the upload" in err, err
+    found = re.search(
+        r"; ((?:P\d+,)*P\d+), sent around it, were created again after it: ((?:P\d+,)*P\d+|none) "
+        r"\(interrupted; the others may be at wrong poses on the controller\)",
+        err,
+    )
+    assert found is not None and "Traceback" not in err, err
+    suspects, again = (set(re.findall(r"P(\d+)", group)) for group in found.groups())
+    assert again <= suspects, (again, suspects)
+    # at the simulator: a point at a wrong pose (the wiped one) is one the CLI did not say it made again
+    wrong = {str(i) for i, pose in sim.state().points.items() if pose != pytest.approx(_pose(i))}
+    assert wrong <= suspects - again, (wrong, suspects, again)
+    record = load_record(record_path(project))
+    assert record is not None and record.points == {} and record.identity.boot is None  # void
 
 
 def test_an_interrupted_upload_resumes_from_its_record_and_another_boot_sends_all(

@@ -13,6 +13,7 @@ from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
 from app.link.jog import JogMachine
 from app.link.poller import Poller
+from app.link.progress import PointUploaded, Progress
 from app.link.sequence import poll
 from app.link.stats import LinkStats
 from app.link.supervisor import LinkSupervisor
@@ -30,6 +31,7 @@ class PartsHost:
 
     def __init__(self, canary_gv: int | None = None) -> None:
         self.out: list[tuple[str, Any]] = []
+        self.progress: list[tuple[int | None, Progress]] = []  # (ticket, report) as published
         self.closed = False
         self.request_id: int | None = None
         self.polling = False
@@ -152,11 +154,12 @@ class PartsHost:
     def publish_foreign_master(self, what: str, value: float) -> None:
         self.out.append(("foreignMaster", (what, value)))
 
-    def publish_upload_progress(self, done: int, total: int) -> None:
-        self.out.append(("uploadProgress", (done, total)))
-
-    def publish_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
-        self.out.append(("pointUploaded", (point_id, ok, reason, unconfirmed)))
+    def publish_progress(self, ticket: int | None, progress: Progress) -> None:
+        """Recorded by kind ("pointUploaded", "uploadProgress": the report's fields) and, with
+        its ticket, in ``progress``."""
+        name = "pointUploaded" if isinstance(progress, PointUploaded) else "uploadProgress"
+        self.out.append((name, dataclasses.astuple(progress)))
+        self.progress.append((ticket, progress))
 
     # --- helpers for tests -----------------------------------------------------------------
     def names(self) -> list[str]:

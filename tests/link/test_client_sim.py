@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import struct
 import threading
 import time
 from collections.abc import Callable
@@ -39,6 +38,7 @@ from app.protocol.enums import (
     TeachFrame,
     WorkMode,
 )
+from tests.link.hostile.server import crc16
 from tests.waits import join
 
 FC06, FC10 = 0x06, 0x10
@@ -626,15 +626,6 @@ def test_broken_observer_does_not_break_the_link(
     c.add_observer(bad)
     assert c.read_status().mode is ControllerMode.AUTO
     assert "traffic observer" in caplog.text
-
-
-def crc16(data: bytes) -> bytes:
-    crc = 0xFFFF
-    for byte in data:
-        crc ^= byte
-        for _ in range(8):
-            crc = (crc >> 1) ^ 0xA001 if crc & 1 else crc >> 1
-    return struct.pack("<H", crc)
 
 
 def test_rtu_framing(sim_factory: Any, make_client: MakeClient) -> None:

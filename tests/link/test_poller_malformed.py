@@ -9,7 +9,6 @@ from __future__ import annotations
 
 import socket
 import struct
-import threading
 from collections.abc import Iterator
 from typing import Any
 
@@ -18,68 +17,28 @@ import pytest
 from app import timing
 from app.link.types import LinkState, Operation
 from tests.link.harness import PartsHost
+from tests.link.hostile.loopback import LoopbackRelay
 
 
-class GarblingProxy:
+class GarblingProxy(LoopbackRelay):
     """Forwards Modbus TCP to ``port``; the next ``garble`` answers lose their last register pair."""
 
+    thread_name = "garbling-proxy"
+
     def __init__(self, port: int) -> None:
-        self._target = port
-        self._listener = socket.create_server(("127.0.0.1", 0))
-        self._listener.settimeout(0.05)
-        self.port: int = self._listener.getsockname()[1]
+        super().__init__(port)
         self.garble = 0
         self.garbled = 0
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._serve, name="garbling-proxy", daemon=True)
-        self._thread.start()
 
-    def close(self) -> None:
-        self._stop.set()
-        self._thread.join(5)
-        self._listener.close()
-
-    def _serve(self) -> None:
-        while not self._stop.is_set():
-            try:
-                conn, _ = self._listener.accept()
-            except TimeoutError:
-                continue
-            with conn, socket.create_connection(("127.0.0.1", self._target)) as upstream:
-                conn.settimeout(0.05)
-                self._pump(conn, upstream)
-
-    @staticmethod
-    def _frame(sock: socket.socket) -> bytes | None:
-        head = b""
-        while len(head) < 7:
-            chunk = sock.recv(7 - len(head))
-            if not chunk:
-                return None
-            head += chunk
+    def _frame(self, sock: socket.socket, *, within: float | None = None) -> bytes:
+        head = self.recv_exact(sock, 7, within=within)
         need = struct.unpack_from(">H", head, 4)[0] - 1
-        body = b""
-        while len(body) < need:
-            chunk = sock.recv(need - len(body))
-            if not chunk:
-                return None
-            body += chunk
-        return head + body
+        return head + self.recv_exact(sock, need, within=within)
 
-    def _pump(self, conn: socket.socket, upstream: socket.socket) -> None:
-        while not self._stop.is_set():
-            try:
-                request = self._frame(conn)
-            except TimeoutError:
-                continue
-            except OSError:
-                return
-            if request is None:
-                return
-            upstream.sendall(request)
-            answer = self._frame(upstream)
-            if answer is None:
-                return
+    def relay(self, conn: socket.socket, upstream: socket.socket) -> None:
+        while not self.stopping:
+            upstream.sendall(self._frame(conn))
+            answer = self._frame(upstream, within=5.0)
             if self.garble > 0 and answer[7] == 0x03 and answer[8] >= 4:
                 self.garble -= 1
                 self.garbled += 1
@@ -89,19 +48,13 @@ class GarblingProxy:
                     + bytes([0x03, answer[8] - 4])
                     + answer[9:-4]
                 )
-            try:
-                conn.sendall(answer)
-            except OSError:
-                return
+            conn.sendall(answer)
 
 
 @pytest.fixture
 def proxy(sim: Any) -> Iterator[GarblingProxy]:
-    p = GarblingProxy(sim.port)
-    try:
+    with GarblingProxy(sim.port) as p:
         yield p
-    finally:
-        p.close()
 
 
 def test_a_malformed_poll_answer_is_a_failed_poll(host: PartsHost, sim: Any, proxy: GarblingProxy) -> None:

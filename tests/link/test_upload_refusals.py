@@ -10,9 +10,11 @@ from typing import Any
 import pytest
 
 from app.link.ops import UploadPoints
+from app.link.progress import PointUploaded
 from app.link.robot_link import RobotLink
 from app.link.types import LinkState
 from app.models import CommandResult
+from tests.link.progress_log import ProgressLog
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     connect,
@@ -37,9 +39,7 @@ class _Watch:
     def __init__(self, link: RobotLink) -> None:
         self.points: list[tuple[int, bool, str]] = []
         self.states: list[LinkState] = []
-        link.pointUploaded.connect(
-            lambda pid, ok, reason, _unconfirmed: self.points.append((pid, ok, reason))
-        )
+        ProgressLog(link, lambda p: self.points.append((p.point_id, p.ok, p.reason)))
         link.connectionChanged.connect(lambda state: self.states.append(state.state))
 
 
@@ -88,11 +88,11 @@ def test_a_link_lost_after_a_refused_point_still_ends_the_upload(
     watch = _Watch(link)
     sim.refuse_point_write(3)
 
-    def silence_at_six(point_id: int, ok: bool, _reason: str, _unconfirmed: bool) -> None:
-        if point_id == 6 and ok:
+    def silence_at_six(point: PointUploaded) -> None:
+        if point.point_id == 6 and point.ok:
             sim.set_silent(True)
 
-    link.pointUploaded.connect(silence_at_six)
+    ProgressLog(link, silence_at_six)
     upload_id = link.submit(UploadPoints.of(_items(200)))
     try:
         with qtbot.waitSignal(

@@ -27,6 +27,7 @@ from app.link.ops import (
     Stop,
     UploadPoints,
 )
+from app.link.progress import PointUploaded
 from app.link.robot_link import RobotLink
 from app.link.types import JogRequest, LinkState, Operation, StepFrame, WorkerError
 from app.link.worker import RobotWorker
@@ -34,6 +35,7 @@ from app.models import CommandResult, Pose
 from app.protocol import registers
 from app.protocol.enums import Alarm, ControllerMode, ProgramState, TeachFrame, WorkMode
 from app.protocol.registers import CANARY_GV
+from tests.link.progress_log import ProgressLog
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     canary_link_fixture,
@@ -348,8 +350,7 @@ def test_points_create_upload_and_move(qtbot: Any, sim: Any, link: RobotLink) ->
     details = blocker.args[0].details
     assert details["x"] == pytest.approx(pose[0], abs=1e-3) and 7 in sim.state().points
     target = (pose[0], pose[1] + 40.0, pose[2], pose[3], pose[4], pose[5])
-    progress: list[tuple[int, int]] = []
-    link.uploadProgress.connect(lambda done, total: progress.append((done, total)))
+    log = ProgressLog(link)
     with qtbot.waitSignal(
         link.commandFinished,
         check_params_cb=_result(lambda r: "uploaded" in r.message),
@@ -357,7 +358,9 @@ def test_points_create_upload_and_move(qtbot: Any, sim: Any, link: RobotLink) ->
     ) as blocker:
         link.submit(UploadPoints.of([(8, target), (9, pose)]))
     assert blocker.args[0].ok and blocker.args[0].message == "uploaded 2 of 2 points"
+    progress = log.counts()
     assert progress[0] == (0, 2) and progress[-1] == (2, 2)
+    assert log.tickets() == [blocker.args[0].request_id]  # under the upload's own ticket
     assert sim.state().points[8] == pytest.approx(target)
     with qtbot.waitSignal(
         link.commandFinished, check_params_cb=_result(lambda r: r.ok), timeout=SIGNAL_TIMEOUT_MS
@@ -443,16 +446,14 @@ def test_upload_reports_each_point_and_cancel_sends_no_stop(qtbot: Any, sim: Any
     # runs the simulator, answered a status read late (as 9a5eede found for the link-loss test)
     connect(qtbot, link, sim, timeout=1.0)
     points: list[tuple[int, bool, str]] = []
-    progress: list[tuple[int, int]] = []
-    link.uploadProgress.connect(lambda done, total: progress.append((done, total)))
     cancel_ids: list[int] = []
 
-    def on_point(point_id: int, ok: bool, reason: str) -> None:
-        points.append((point_id, ok, reason))
+    def on_point(point: PointUploaded) -> None:
+        points.append((point.point_id, point.ok, point.reason))
         if len(points) == 150:
             cancel_ids.append(link.submit(CancelUpload()))
 
-    link.pointUploaded.connect(on_point)
+    log = ProgressLog(link, on_point)
     items = _poses(sim, range(1, 301))
     upload_id = link.submit(UploadPoints.of(items))
     with qtbot.waitSignal(
@@ -467,7 +468,9 @@ def test_upload_reports_each_point_and_cancel_sends_no_stop(qtbot: Any, sim: Any
     assert batch.details["uploaded"] == len(uploaded)
     assert sorted(sim.state().points) == uploaded  # exactly those, nothing half-made
     assert register_writes(sim, 441) == []  # cancel is not a controller stop
+    progress = log.counts(upload_id)
     assert progress[0] == (0, 300) and progress[-1] == (len(uploaded), 300)
+    assert log.tickets() == [upload_id]
     assert len(progress) <= 2 + 20 * 30  # rate-limited (<= ~20/s; generous bound for a slow machine)
     assert cancel_ids and cancel_ids[0] > upload_id
 
@@ -540,8 +543,7 @@ def test_upload_tool_per_point_writes_gv245_once_per_tool(qtbot: Any, sim: Any, 
     x, y, z, a, b, c = sim.state().pose
     tools = {1: 200, 2: 3, 3: 200, 4: 3, 5: 5, 6: 200}
     items = [(pid, (x, y + pid, z, a, b, c), tool) for pid, tool in tools.items()]
-    order: list[int] = []
-    link.pointUploaded.connect(lambda pid, ok, _reason: order.append(pid) if ok else None)
+    log = ProgressLog(link)
     with qtbot.waitSignal(
         link.commandFinished,
         check_params_cb=_result(lambda r: "uploaded" in r.message),
@@ -549,6 +551,7 @@ def test_upload_tool_per_point_writes_gv245_once_per_tool(qtbot: Any, sim: Any, 
     ) as done:
         link.submit(UploadPoints.of(items))
     assert done.args[0].ok
+    order = [p.point_id for p in log.points() if p.ok]
     assert order == [1, 3, 6, 2, 4, 5]  # grouped by tool, first appearance first
     with sim.lock:
         stored = {pid: point.tool for pid, point in sim.robot.points.items()}

@@ -16,6 +16,7 @@ from app.link.robot_link import RobotLink
 from app.link.types import JogRequest, WorkerError
 from app.models import CommandResult
 from app.protocol import registers
+from tests.link.progress_log import ProgressLog
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     connect,
@@ -56,8 +57,7 @@ def test_a_stop_ends_an_upload_at_once_even_when_the_point_in_flight_never_gets_
     monkeypatch.setattr(timing, "CREATE_POINT_TIMEOUT", 10.0)
     sim = sim_factory(command_latency=60.0)
     connect(qtbot, link, sim)
-    points: list[tuple[int, bool, str]] = []
-    link.pointUploaded.connect(lambda pid, ok, reason: points.append((pid, ok, reason)))
+    log = ProgressLog(link)
     results: list[CommandResult] = []
     link.commandFinished.connect(results.append)
     upload_id = link.submit(UploadPoints.of(_poses(sim, range(1, 6))))
@@ -73,7 +73,8 @@ def test_a_stop_ends_an_upload_at_once_even_when_the_point_in_flight_never_gets_
     assert elapsed < 1.0  # ms on an idle machine
     assert done.args[0].message == "uploaded 0 of 5 points (stopped)" and not done.args[0].ok
     assert any(r.request_id == stop_id and r.ok for r in results)  # the Stop's own result
-    [(pid, ok, reason)] = points  # the point in flight: failed, stopped, never "created"
+    [point] = log.points(upload_id)  # the point in flight: failed, stopped, never "created"
+    pid, ok, reason = point.point_id, point.ok, point.reason
     assert (pid, ok) == (1, False) and "stopped by the operator" in reason and "not confirmed" in reason
     # at the simulator: one point started (its next pose may have been staged meanwhile), then
     # the stop(s) -- the line's and the main link's -- and nothing more of the upload

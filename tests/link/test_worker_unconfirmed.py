@@ -3,6 +3,7 @@ controller took without any visible change of its status is UNCONFIRMED, never O
 
 from __future__ import annotations
 
+import dataclasses
 from typing import Any
 
 import pytest
@@ -13,6 +14,7 @@ from app.models import CommandResult
 from app.points.ledger import PointLedger
 from app.points.point import SyncState, make_point
 from app.points.upload import UploadOutcome, UploadReport, apply_upload
+from tests.link.progress_log import ProgressLog
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     connect,
@@ -33,8 +35,7 @@ def test_upload_carries_unconfirmed(
     # read-only GV291 nothing tells this point's create from the last one: done, unconfirmed.
     sim = sim_factory(timing="fast", gv291=gv291)
     connect(qtbot, link, sim, unconfirmed_after=0.05)
-    seen: list[tuple[int, bool, str, bool]] = []
-    link.pointUploaded.connect(lambda *args: seen.append(args))
+    log = ProgressLog(link)
     with qtbot.waitSignal(
         link.commandFinished,
         check_params_cb=lambda r: isinstance(r, CommandResult) and r.message.startswith("uploaded"),
@@ -42,6 +43,7 @@ def test_upload_carries_unconfirmed(
     ) as done:
         link.submit(UploadPoints.of([(pid, pose, 0) for pid, pose in POSES.items()]))
     assert done.args[0].ok
+    seen = [dataclasses.astuple(p) for p in log.points()]
     assert [(pid, ok) for pid, ok, _, _ in seen] == [(5, True), (6, True)]
     # The first create may still see GV291 change from its power-on value; the second cannot.
     assert seen[-1][3] is unconfirmed and (unconfirmed or not seen[0][3])

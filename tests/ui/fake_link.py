@@ -3,8 +3,9 @@
 It holds a real :class:`RobotState` and a real :class:`RequestRouter`, so the code under test
 sees the real types and the real request-id routing; the submitted operations
 (:mod:`app.link.ops`) are recorded, not sent: a test reads them as data (``link.named(MoveToPoint)``). Tests
-play the worker: ``commandFinished.emit(result)`` / ``errorOccurred.emit(error)`` go through the
-router exactly like the link's, ``set_connected`` changes ``state.connection``.
+play the worker: ``commandFinished.emit(result)`` / ``errorOccurred.emit(error)`` /
+``progressed.emit(ticket, progress)`` go through the router exactly like the link's,
+``set_connected`` changes ``state.connection``.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ from PySide6.QtCore import QObject, Signal
 
 from app.link.link_port import LinkPort, Pending, RequestRouter
 from app.link.ops import CreatePoint, LinkOp, MoveToPoint, Stop, UploadPoints
+from app.link.progress import PointUploaded, UploadProgress
 from app.link.state import RobotState
 from app.link.types import ConnectionState, ControllerIdentity, LinkState
 from app.models import CommandResult
@@ -46,8 +48,7 @@ class FakeLink(QObject):
     controllerReconnected = Signal()  # noqa: N815
     controllerRestarted = Signal()  # noqa: N815
     foreignMaster = Signal(str, float)  # noqa: N815
-    uploadProgress = Signal(int, int)  # noqa: N815
-    pointUploaded = Signal(int, bool, str, bool)  # noqa: N815
+    progressed = Signal(int, object)  # ticket, Progress (app/link/progress.py): routed like RobotLink's
 
     def __init__(self, connected: bool = True) -> None:
         super().__init__()
@@ -56,6 +57,7 @@ class FakeLink(QObject):
         self.commandFinished.connect(self._state.set_last_result)
         self.commandFinished.connect(self._router.on_result)
         self.errorOccurred.connect(self._router.on_error)
+        self.progressed.connect(self._router.on_progress)
         self.submitted: list[Submitted] = []
         self._next_id = 100
         if connected:
@@ -138,12 +140,19 @@ class FakeLink(QObject):
         )
         self.commandFinished.emit(result)
 
-    def point_ok(self, *point_ids: int) -> None:
+    def point_ok(self, *point_ids: int, ticket: int | None = None) -> None:
+        """Each point created, reported under ``ticket`` (default: the latest upload's)."""
         for point_id in point_ids:
-            self.pointUploaded.emit(point_id, True, "", False)
+            self.progressed.emit(self._upload_ticket(ticket), PointUploaded(point_id, True))
 
-    def point_failed(self, point_id: int, message: str) -> None:
-        self.pointUploaded.emit(point_id, False, message, False)
+    def point_failed(self, point_id: int, message: str, *, ticket: int | None = None) -> None:
+        self.progressed.emit(self._upload_ticket(ticket), PointUploaded(point_id, False, message))
+
+    def upload_progress(self, done: int, total: int, *, ticket: int | None = None) -> None:
+        self.progressed.emit(self._upload_ticket(ticket), UploadProgress(done, total))
+
+    def _upload_ticket(self, ticket: int | None) -> int:
+        return self.last_id(UploadPoints) if ticket is None else ticket
 
     def upload_summary(self, uploaded: int, total: int, reason: str = "") -> None:
         text = f"uploaded {uploaded} of {total} points" + (f" ({reason})" if reason else "")

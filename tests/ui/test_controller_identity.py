@@ -21,6 +21,7 @@ from app.link.types import LinkState, StepFrame
 from app.points.point import SyncState
 from app.protocol.enums import RunCommand
 from app.protocol.registers import CANARY_GV, REG_RUN_COMMAND
+from tests.link.progress_log import ProgressLog
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     QT_LOG_IGNORE,
     SIGNAL_TIMEOUT_MS,
@@ -214,7 +215,7 @@ def test_bad_end_point_id_makes_the_point_unknown(
     _connect(qtbot, window, sim)
     _teach_five(qtbot, window, sim, make_client)
     # the controller forgets P1 right after any create of it (here: before the move goes out)
-    window.link.pointUploaded.connect(lambda point_id, *_: sim.remove_point(point_id))
+    ProgressLog(window.link, lambda point: sim.remove_point(point.point_id))
     sim.remove_point(1)  # and before: today's Move to point sends 0x42 without creating it
     since = len(sim.writes)
 

@@ -56,6 +56,7 @@ from app import timing
 from app.errors import LinkError, TeachPadError
 from app.link.link_port import LinkPort, Pending
 from app.link.ops import MoveToPoint, Pause, Resume, Stop, UploadPoints
+from app.link.progress import PointUploaded, Progress
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult, Pose
 from app.plan.segments import Plan, Segment
@@ -143,7 +144,6 @@ class PlanRunController(QObject):
             raise RuntimeError("the link is already set")
         self._link = link
         link.state.connectionChanged.connect(self._on_connection)
-        link.pointUploaded.connect(self._on_point_uploaded)
         link.foreignMaster.connect(self._on_foreign_master)
 
     @property
@@ -441,6 +441,7 @@ class PlanRunController(QObject):
         self._prepared = prepared
         upload = link.track(link.submit(UploadPoints.of(prepared.items())))
         self._upload = upload
+        upload.progressed.connect(lambda progress: self._on_upload_progress(upload, progress))
         upload.finished.connect(lambda result: self._on_upload(upload, result))
         upload.failed.connect(lambda error: self._on_upload_error(upload, error))
 
@@ -502,9 +503,11 @@ class PlanRunController(QObject):
         self._deferred = False
         self._guard.clear()
 
-    def _on_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
-        if self._upload is not None:
-            self._guard.on_point_uploaded(point_id, ok, reason, unconfirmed)
+    def _on_upload_progress(self, upload: Pending, progress: Progress) -> None:
+        """One point of the segment's upload (its own request's: ``upload``'s progress)."""
+        if upload is self._upload and isinstance(progress, PointUploaded):
+            point = progress
+            self._guard.on_point_uploaded(point.point_id, point.ok, point.reason, point.unconfirmed)
 
     def _send_move(self, link: LinkPort, command: SegmentCommand) -> None:
         seg = command.segment

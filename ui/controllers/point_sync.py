@@ -9,9 +9,10 @@ and says what happened through signals. The points panel and the planner share o
 The link is a :class:`~app.link.robot_link.LinkPort`. Each request's outcome comes back on its
 own :class:`~app.link.robot_link.Pending` (``link.track(request_id)``), so nothing here matches
 ids. Connection and pose are read from ``link.state`` (:class:`~app.link.state.RobotState`). An
-upload is one request: ``pointUploaded`` marks each point on the controller / failed as it goes
-(applied to the ledger at each ``uploadProgress`` and at the end, so a cancel or a lost link
-half way leaves exact states), and the batch's result ends it. The points the controller
+upload is one request: its Pending's progress (:mod:`app.link.progress`, this request's only)
+marks each point on the controller / failed as it goes (a ``PointUploaded``; applied to the
+ledger at each ``UploadProgress`` and at the end, so a cancel or a lost link half way leaves
+exact states), and the batch's result ends it. The points the controller
 created go into the project's upload history as they are applied (``project.record_upload``
 with the link's endpoint, like the CLI's ``points upload``): history only, never proof that
 the controller still holds them. Teach reads the pose back from
@@ -45,6 +46,7 @@ from PySide6.QtCore import QObject, Signal, Slot
 from app.errors import InvalidInput
 from app.link.link_port import LinkPort, Pending
 from app.link.ops import CancelUpload, CreatePoint, MoveToPoint, Stop, UploadPoints
+from app.link.progress import PointUploaded, Progress, UploadProgress
 from app.link.types import ConnectionState, ControllerIdentity, WorkerError
 from app.models import CommandResult, Pose
 from app.points.point import SyncState
@@ -162,8 +164,6 @@ class PointSyncController(QObject):
         # (_on_connection): a restart seen by the canary is a new identity, published before
         # controllerRestarted; a reconnect to the same boot keeps the states.
         link.state.connectionChanged.connect(self._on_connection)
-        link.uploadProgress.connect(self._on_upload_progress)
-        link.pointUploaded.connect(self._on_point_uploaded)
 
     # --- operations (return False, with a statusMessage, when they cannot start)
     def teach(self, name: str = "") -> int | None:
@@ -317,9 +317,10 @@ class PointSyncController(QObject):
 
     # --- internals
     def _watch(self, link: LinkPort, request_id: int) -> None:
-        """Hear the outcome of this request (and of no other)."""
+        """Hear the progress and outcome of this request (and of no other)."""
         pending = link.track(request_id)
         self._pending = pending
+        pending.progressed.connect(lambda progress: self._on_progress(pending, progress))
         pending.finished.connect(lambda result: self._on_result(pending, result))
         pending.failed.connect(lambda error: self._on_error(pending, error))
 
@@ -515,12 +516,20 @@ class PointSyncController(QObject):
             self._offer_restore(True)
 
     # upload
-    @Slot(int, bool, str, bool)
-    def _on_point_uploaded(self, point_id: int, ok: bool, reason: str, unconfirmed: bool = False) -> None:
+    def _on_progress(self, pending: Pending, progress: Progress) -> None:
+        """The progress of the request under way (an upload's, or the upload of a move's point)."""
+        if pending is not self._pending:
+            return  # an operation that was already given up
+        if isinstance(progress, PointUploaded):
+            self._on_point_uploaded(progress)
+        else:
+            self._on_upload_progress(progress)
+
+    def _on_point_uploaded(self, point: PointUploaded) -> None:
         if self._upload is not None:
-            self._upload.record(point_id, ok, reason, unconfirmed)
-        elif self._operation == "move":  # the move's own point (others are ignored there)
-            self._guard.on_point_uploaded(point_id, ok, reason, unconfirmed)
+            self._upload.record(point.point_id, point.ok, point.reason, point.unconfirmed)
+        elif self._operation == "move":  # the move's own point
+            self._guard.on_point_uploaded(point.point_id, point.ok, point.reason, point.unconfirmed)
 
     def _flush_upload(self) -> None:
         """Apply the outcomes reported since the last flush to the ledger (one model update)."""
@@ -533,12 +542,11 @@ class PointSyncController(QObject):
                 self._model.project.record_upload(created, endpoint or "controller")
             self._model.apply_upload(UploadReport(outcomes=batch))
 
-    @Slot(int, int)
-    def _on_upload_progress(self, done: int, total: int) -> None:
+    def _on_upload_progress(self, progress: UploadProgress) -> None:
         upload = self._upload
         if upload is not None and self._operation == "upload":
             self._flush_upload()
-            self.uploadProgress.emit(min(done, upload.total), upload.total)
+            self.uploadProgress.emit(min(progress.done, upload.total), upload.total)
 
     def _upload_done(self, result: CommandResult) -> None:
         upload = self._upload

@@ -8,7 +8,8 @@ wrong), the simulator's correct answer is read, and a :data:`Misbehaviour` aimed
 one, nothing, a hang-up, the previous answer first... Every exchange is logged
 (:class:`Exchange`) so a test can tell which request got which answer.
 
-One client connection at a time, in one thread, like a controller with a single Modbus slot.
+One client connection at a time, in one thread, like a controller with a single Modbus slot
+(:class:`~tests.link.hostile.loopback.LoopbackRelay`, the hostile server's start code too).
 """
 
 from __future__ import annotations
@@ -20,9 +21,13 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 
+from tests.link.hostile.loopback import LoopbackRelay
 from tests.link.hostile.server import Answer, Framing, Reply, crc16
 
 __all__ = ["Exchange", "HostileRelay", "Later", "Misbehaviour"]
+
+#: s the relay waits for the simulator's answer to a request before it gives the connection up
+ANSWER_WITHIN = 5.0
 
 #: What the client gets for one request: from the correct answer and the answer sent before it
 #: on this relay (b"" before the first).
@@ -71,34 +76,22 @@ class _Aim:
     used: bool = field(default=False)
 
 
-class HostileRelay:
+class HostileRelay(LoopbackRelay):
     """See the module docstring. ``with HostileRelay(sim.port, "tcp") as relay: ... relay.port``."""
 
+    thread_name = "hostile-relay"
+
     def __init__(self, upstream_port: int, framing: Framing = "tcp", *, unit: int = 1) -> None:
+        super().__init__(upstream_port)
         self.framing = framing
         self.unit = unit
-        self._upstream_port = upstream_port
         self._aims: dict[int, _Aim] = {}
         self._lock = threading.Lock()
         self.count = 0  # requests since arm()
         self.log: list[Exchange] = []
         self._previous = b""
-        self._listener = socket.create_server(("127.0.0.1", 0))
-        self._listener.settimeout(0.05)
-        self.port: int = self._listener.getsockname()[1]
-        self._stop = threading.Event()
-        self._thread = threading.Thread(target=self._serve, name="hostile-relay", daemon=True)
 
     # -- control ------------------------------------------------------------------------
-    def __enter__(self) -> HostileRelay:
-        self._thread.start()
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self._stop.set()
-        self._thread.join(5)
-        self._listener.close()
-
     def arm(self, aims: dict[int, tuple[str, Misbehaviour]] | None = None) -> None:
         """Count requests from 0 again, forget the log; ``aims``: request index -> misbehaviour."""
         with self._lock:
@@ -117,59 +110,19 @@ class HostileRelay:
             return list(self.log)
 
     # -- the relay thread ---------------------------------------------------------------
-    def _serve(self) -> None:
-        while not self._stop.is_set():
-            try:
-                conn, _ = self._listener.accept()
-            except TimeoutError:
-                continue
-            conn.settimeout(0.05)
-            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            try:
-                upstream = socket.create_connection(("127.0.0.1", self._upstream_port), timeout=5)
-            except OSError:
-                conn.close()
-                continue
-            upstream.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            self._previous = b""  # a late answer comes on the connection of its request
-            try:
-                self._relay(conn, upstream)
-            except (ConnectionError, OSError):
-                pass  # the client went away (or the simulator): take the next connection
-            finally:
-                upstream.close()
-                conn.close()
-
-    def _recv_exact(self, conn: socket.socket, n: int, *, patient: bool = True) -> bytes:
-        buf = b""
-        deadline = time.monotonic() + 5.0
-        while len(buf) < n:
-            if self._stop.is_set():
-                raise ConnectionError("stopping")
-            try:
-                chunk = conn.recv(n - len(buf))
-            except TimeoutError:
-                if not patient and time.monotonic() > deadline:
-                    raise ConnectionError("the simulator did not answer") from None
-                continue
-            if not chunk:
-                raise ConnectionError("closed")
-            buf += chunk
-        return buf
-
     def _read_frame(self, conn: socket.socket, *, answer: bool) -> bytes:
-        """One whole frame (a request from the client, or the simulator's answer)."""
-        patient = not answer
+        """One whole frame (a request from the client, or the simulator's answer: within 5 s)."""
+        within = ANSWER_WITHIN if answer else None
         if self.framing == "tcp":
-            head = self._recv_exact(conn, 7, patient=patient)
+            head = self.recv_exact(conn, 7, within=within)
             (length,) = struct.unpack_from(">H", head, 4)
-            return head + self._recv_exact(conn, length - 1, patient=patient)
-        head = self._recv_exact(conn, 3, patient=patient)  # unit, function, 3rd byte
+            return head + self.recv_exact(conn, length - 1, within=within)
+        head = self.recv_exact(conn, 3, within=within)  # unit, function, 3rd byte
         fc = head[1]
         rest = self._rtu_rest(fc, head[2]) if answer else 5 if fc in (0x03, 0x06) else 4
-        frame = head + self._recv_exact(conn, rest, patient=patient)
+        frame = head + self.recv_exact(conn, rest, within=within)
         if not answer and fc == 0x10:
-            frame += self._recv_exact(conn, frame[6] + 2, patient=patient)
+            frame += self.recv_exact(conn, frame[6] + 2, within=within)
         return frame
 
     @staticmethod
@@ -187,9 +140,9 @@ class HostileRelay:
         assert frame[-2:] == crc16(frame[:-2]), "a bad CRC on the loopback"
         return 0, frame[0], frame[1:-2]
 
-    def _relay(self, conn: socket.socket, upstream: socket.socket) -> None:
-        upstream.settimeout(0.05)
-        while not self._stop.is_set():
+    def relay(self, conn: socket.socket, upstream: socket.socket) -> None:
+        self._previous = b""  # a late answer comes on the connection of its request
+        while not self.stopping:
             request = self._read_frame(conn, answer=False)
             upstream.sendall(request)
             tid, unit, pdu = self._pdu(request)

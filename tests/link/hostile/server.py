@@ -5,7 +5,8 @@ It speaks Modbus TCP (MBAP) or RTU framing over TCP, on 127.0.0.1:<free port>, a
 then hands it to a :data:`Mutation` (the next one queued with :meth:`HostileServer.push`, else
 the default) which decides what is really sent: the correct frame, a malformed one, nothing
 (silence), and whether the connection is closed afterwards. One connection at a time, in one
-thread, like a controller with a single Modbus slot.
+thread, like a controller with a single Modbus slot (:class:`~tests.link.hostile.loopback.Loopback`,
+the hostile relay's start code too).
 """
 
 from __future__ import annotations
@@ -17,6 +18,8 @@ from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal
+
+from tests.link.hostile.loopback import Loopback
 
 Framing = Literal["tcp", "rtu"]
 
@@ -93,10 +96,13 @@ def silent(answer: Answer) -> Reply:
     return Reply(None)
 
 
-class HostileServer:
+class HostileServer(Loopback):
     """See the module docstring. ``with HostileServer("tcp") as server: ... server.port``."""
 
+    thread_name = "hostile-server"
+
     def __init__(self, framing: Framing, unit: int = 1) -> None:
+        super().__init__()
         self.framing = framing
         self.unit = unit
         self.registers = [bank_value(a) for a in range(0x10000)]
@@ -104,24 +110,10 @@ class HostileServer:
         self._script: deque[Mutation] = deque()
         self.requests = 0
         self.last: tuple[bytes, bytes | None] | None = None  # (correct frame, what was sent)
-        self._listener = socket.create_server(("127.0.0.1", 0))
-        self._listener.settimeout(0.05)
-        self.port: int = self._listener.getsockname()[1]
         self._conn: socket.socket | None = None
-        self._stop = threading.Event()
         self._lock = threading.Lock()
-        self._thread = threading.Thread(target=self._serve, name="hostile-server", daemon=True)
 
     # -- control ------------------------------------------------------------------------
-    def __enter__(self) -> HostileServer:
-        self._thread.start()
-        return self
-
-    def __exit__(self, *exc: object) -> None:
-        self._stop.set()
-        self._thread.join(5)
-        self._listener.close()
-
     def push(self, *mutations: Mutation) -> None:
         """Answer the next requests with these, in order (then the default again)."""
         self._script.extend(mutations)
@@ -133,46 +125,22 @@ class HostileServer:
             self._conn.sendall(data)
 
     # -- the server thread ----------------------------------------------------------------
-    def _serve(self) -> None:
-        while not self._stop.is_set():
-            try:
-                conn, _ = self._listener.accept()
-            except TimeoutError:
-                continue
-            conn.settimeout(0.05)
-            conn.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-            self._conn = conn
-            try:
-                self._serve_connection(conn)
-            except (ConnectionError, OSError):
-                pass  # the client went away: take the next connection
-            finally:
-                with self._lock:
-                    self._conn = None
-                    conn.close()
-
-    def _recv_exact(self, conn: socket.socket, n: int) -> bytes:
-        buf = b""
-        while len(buf) < n:
-            if self._stop.is_set():
-                raise ConnectionError("stopping")
-            try:
-                chunk = conn.recv(n - len(buf))
-            except TimeoutError:
-                continue
-            if not chunk:
-                raise ConnectionError("client closed")
-            buf += chunk
-        return buf
+    def serve(self, conn: socket.socket) -> None:
+        self._conn = conn
+        try:
+            self._serve_connection(conn)
+        finally:
+            with self._lock:
+                self._conn = None
 
     def _read_request(self, conn: socket.socket) -> tuple[int, int, bytes]:
         """(tid, unit, request PDU)."""
         if self.framing == "tcp":
-            tid, _, length, unit = struct.unpack(">HHHB", self._recv_exact(conn, 7))
-            return tid, unit, self._recv_exact(conn, length - 1)
-        head = self._recv_exact(conn, 7)  # unit, fc, address, count/value, first byte after
+            tid, _, length, unit = struct.unpack(">HHHB", self.recv_exact(conn, 7))
+            return tid, unit, self.recv_exact(conn, length - 1)
+        head = self.recv_exact(conn, 7)  # unit, fc, address, count/value, first byte after
         rest = 1 if head[1] in (0x03, 0x06) else head[6] + 2  # CRC's 2nd byte / data + CRC
-        frame = head + self._recv_exact(conn, rest)
+        frame = head + self.recv_exact(conn, rest)
         assert frame[-2:] == crc16(frame[:-2]), "the client sent a bad CRC"
         return 0, frame[0], frame[1:-2]
 
@@ -191,7 +159,7 @@ class HostileServer:
         return bytes([fc | 0x80, 0x01])
 
     def _serve_connection(self, conn: socket.socket) -> None:
-        while not self._stop.is_set():
+        while not self.stopping:
             tid, unit, request = self._read_request(conn)
             self.requests += 1
             answer = Answer(self.framing, tid, unit, request, self._answer_pdu(request))

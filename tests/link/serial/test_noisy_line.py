@@ -28,6 +28,7 @@ from app.protocol import registers
 from app.sim.config import SimConfig
 from app.sim.server import SimController
 from benchmarks.noisy_line import project_points, wrong_points
+from tests.link.progress_log import ProgressLog
 from tests.link.serial.relay import PtyRelay
 from tests.ui.pendant_support import SIGNAL_TIMEOUT_MS, is_state
 
@@ -118,8 +119,7 @@ def test_the_gui_upload_over_a_noisy_line_completes_with_no_wrong_point(
             link.connect_to(settings)
         states: list[LinkState] = []
         link.connectionChanged.connect(lambda s: states.append(s.state))
-        uploaded: list[tuple[int, bool, str]] = []
-        link.pointUploaded.connect(lambda pid, ok, why: uploaded.append((pid, ok, why)))
+        log = ProgressLog(link)
         finished: list[CommandResult] = []
         link.commandFinished.connect(finished.append)
         request = link.submit(UploadPoints.of([(p.id, p.xyzabc, p.tool) for p in points]))
@@ -127,7 +127,7 @@ def test_the_gui_upload_over_a_noisy_line_completes_with_no_wrong_point(
         result = next(r for r in finished if r.request_id == request)
         assert result.ok, result.message
         assert result.message.startswith(f"uploaded {N} of {N} points")
-        assert [pid for pid, ok, _ in uploaded if ok] == [p.id for p in points]
+        assert [p.point_id for p in log.points(request) if p.ok] == [p.id for p in points]
         # never lost for a damaged frame (a poll whose every try was damaged may show "not answering"
         # until the next good poll: a pose answer is 205 bytes, a third of them damaged at 1 in 500)
         assert LinkState.DOWN not in states and LinkState.DISCONNECTED not in states, states

@@ -150,12 +150,12 @@ def test_upload_selected_with_progress_and_a_refused_point(
     assert panel.progress_row.isVisibleTo(panel)
     ledger = panel.model.ledger
     link.point_ok(1)
-    link.uploadProgress.emit(1, 3)
+    link.upload_progress(1, 3)
     assert panel.progress.value() == 1
     assert ledger.point(1).sync is SyncState.ON_CONTROLLER  # marked as it goes
     link.point_failed(3, "point 3: bad point id")
     link.point_ok(5)
-    link.uploadProgress.emit(3, 3)
+    link.upload_progress(3, 3)
     assert ledger.point(3).sync is SyncState.FAILED and "bad point id" in ledger.point(3).sync_error
     with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
         link.upload_summary(2, 3)
@@ -172,7 +172,7 @@ def test_cancel_half_way_keeps_what_was_uploaded(qtbot: Any, panel: PointsPanel,
     panel.model.setData(panel.model.index(5, COL_X), "401")  # P6 changed on host
     panel.upload_all()
     link.point_ok(1, 2)
-    link.uploadProgress.emit(2, 8)
+    link.upload_progress(2, 8)
     panel.action_cancel_upload.trigger()
     assert link.named(CancelUpload) and not link.named(Stop)  # no controller stop
     assert panel.controller.busy  # until the link says the batch ended
@@ -202,7 +202,7 @@ def test_upload_sends_each_points_tool_in_one_request(qtbot: Any, panel: PointsP
     assert [(pid, tool) for pid, _, tool in call.items] == [(1, 200), (2, 4), (3, 200)]
     link.point_ok(1, 3, 2)
     with qtbot.waitSignal(panel.controller.uploadFinished) as finished:
-        link.uploadProgress.emit(3, 3)
+        link.upload_progress(3, 3)
         assert panel.progress.value() == 3
         link.upload_summary(3, 3)
     assert finished.args[0].all_ok

@@ -9,9 +9,11 @@ from typing import Any
 import pytest
 from PySide6.QtGui import QUndoStack
 
+from app.link.progress import PointUploaded
 from app.link.robot_link import RobotLink
 from app.points.point import SyncState, make_point
 from app.points.project_model import Project
+from tests.link.progress_log import ProgressLog
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
     canary_link_fixture,
@@ -69,13 +71,13 @@ def test_cancel_half_way_leaves_the_ledger_exactly_as_the_controller(
     controller = panel.controller
     reported: list[int] = []
 
-    def on_point(point_id: int, ok: bool, _reason: str) -> None:
-        if ok:
-            reported.append(point_id)
+    def on_point(point: PointUploaded) -> None:
+        if point.ok:
+            reported.append(point.point_id)
         if len(reported) == 150:
             controller.cancel_upload()
 
-    link.pointUploaded.connect(on_point)
+    ProgressLog(link, on_point)
     with qtbot.waitSignal(controller.uploadFinished, timeout=60_000) as finished:
         panel.upload_all()
     report = finished.args[0]
@@ -101,13 +103,13 @@ def test_link_loss_half_way_keeps_every_reported_point(qtbot: Any, sim: Any, lin
     controller = panel.controller
     reported: list[int] = []
 
-    def on_point(point_id: int, ok: bool, _reason: str) -> None:
-        if ok:
-            reported.append(point_id)
+    def on_point(point: PointUploaded) -> None:
+        if point.ok:
+            reported.append(point.point_id)
         if len(reported) == 100:
             sim.set_silent(True)
 
-    link.pointUploaded.connect(on_point)
+    ProgressLog(link, on_point)
     try:  # the simulator answers again whatever happens: a failure is then one failure, not also
         # a shutdown that waits on the silence in the fixture's teardown
         with qtbot.waitSignal(controller.uploadFinished, timeout=60_000) as finished:
