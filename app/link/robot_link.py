@@ -68,6 +68,7 @@ class RobotLink(QObject):
     uploadProgress = Signal(int, int)  # noqa: N815
     pointUploaded = Signal(int, bool, str, bool)  # noqa: N815
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard stopped a jog
+    watchRead = Signal(object)  # noqa: N815 - WatchReadings: the watch list's values (app/link/watch_list.py)
 
     _connectRequested = Signal(object)  # noqa: N815
     _disconnectRequested = Signal()  # noqa: N815
@@ -156,6 +157,7 @@ class RobotLink(QObject):
             (w.uploadProgress, self.uploadProgress),
             (w.pointUploaded, self.pointUploaded),
             (w.jogGuardStopped, self.jogGuardStopped),
+            (w.watchRead, self.watchRead),
             (w.haltChanged, state.set_halt),
             (self._connectRequested, w.connect_to),
             (self._disconnectRequested, w.disconnect_link),

@@ -88,6 +88,7 @@ from app.link.supervisor import LinkSupervisor
 from app.link.transport import TrafficRecord
 from app.link.types import ConnectionState, LinkState, Operation, UnconfirmedHalt, WorkerError
 from app.link.upload import Uploader
+from app.link.watch_list import WatchListReader
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.registers import CANARY_GV
 from app.safety.audit import AuditLog
@@ -128,6 +129,7 @@ class RobotWorker(QObject):
     pointUploaded = Signal(int, bool, str, bool)  # noqa: N815 - point id, ok, reason ("" when ok), unconfirmed
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard wrote ratio 0
     haltChanged = Signal(object)  # noqa: N815 - UnconfirmedHalt | None: a stop the controller has not confirmed
+    watchRead = Signal(object)  # noqa: N815 - WatchReadings: the watch list's reads of a poll (none: no list)
     stopped = Signal()  # the worker has closed the link and is quitting its thread (shutdown)
 
     # Wakes the worker from any thread (a queued call, since the worker lives in its thread).
@@ -175,6 +177,8 @@ class RobotWorker(QObject):
         )
         self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
         self.commands = WorkerCommands(self)  # the short commands' handlers
+        self.watch_list = WatchListReader(self, self.watchRead.emit)  # read after the pose (poller.py)
+        self.poller.watch_list = self.watch_list
         self.handlers = self._make_handlers()
 
     def _make_handlers(self) -> Handlers:
@@ -183,6 +187,7 @@ class RobotWorker(QObject):
         handlers = Handlers()
         self.commands.register(handlers)  # the short ones (stop, pause, the jog ...)
         self.motions.register(handlers)  # the long ones (step, move to point ...)
+        self.watch_list.register(handlers)  # the watch list and an engineer's write of a value
         return handlers
 
     # --- requests (any thread) ----------------------------------------------------------
