@@ -201,7 +201,7 @@ def _whole(value: object, name: str, lo: int, hi: int) -> int:
     if isinstance(value, str):
         text = value.strip().lower().replace("_", "")
         try:
-            value = int(text, 2) if text.startswith("0b") else int(text, 16) if text.startswith("0x") else int(text)
+            value = int(text, 0) if text[:2] in ("0b", "0x") else int(text)
         except ValueError:
             raise InvalidInput(f"{name}: {text[:20]!r} is not a whole number", code="watch_not_a_number") from None
     if isinstance(value, float) and math.isfinite(value) and value.is_integer():
