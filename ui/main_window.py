@@ -75,6 +75,7 @@ from ui.window_actions import WindowActions
 from ui.window_cell import install_cell
 from ui.window_column import ControlColumn
 from ui.window_docks import WindowDocks
+from ui.window_watch_list import install_watch_list
 from ui.window_geometry import MIN_SIZE, default_size, restore_window
 from ui.window_rows import add_window_rows
 from ui.window_status import WindowStatusBar
@@ -197,6 +198,7 @@ class MainWindow(QMainWindow):
         self.motion.safety = self.safety_menu.safety
         self.run_controller.audit = self.safety_menu.safety.session.audit  # a run's own pause (issue 19)
         self.cell = install_cell(self)  # File → Open cell…, the Cell tab (issue 23)
+        self.watch_list = install_watch_list(self)  # View → Watch list (issue 24)
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])

@@ -83,6 +83,7 @@ class WatchListReader:
             raise InvalidInput(
                 f"{entry.label}: registers 440..445 are the controller's commands; use the motion controls",
                 code="watch_write_control",
+                params={"what": entry.label},
             )
         client = self._host.client_or_raise()
         order = client.settings.word_order
@@ -94,7 +95,14 @@ class WatchListReader:
         shown = format_value(entry, entry.decode(regs, order))
         text = f"{entry.title} ({entry.label}) = {shown}: written"
         self._host.emit_result(
-            CommandResult(None, None, None, True, text, reason=Reason("watch_written", {"what": entry.title, "value": shown}))
+            CommandResult(
+                None,
+                None,
+                None,
+                True,
+                text,
+                reason=Reason("watch_written", {"what": entry.title, "value": shown}),
+            )
         )
         self._read_back(client, entry)
 

@@ -63,7 +63,13 @@ class ValueType(enum.Enum):
     @classmethod
     def parse(cls, text: str) -> ValueType:
         key = text.strip().lower()
-        aliases = {"float": cls.FLOAT32, "f32": cls.FLOAT32, "i16": cls.INT16, "int": cls.INT16, "bit": cls.BITS}
+        aliases = {
+            "float": cls.FLOAT32,
+            "f32": cls.FLOAT32,
+            "i16": cls.INT16,
+            "int": cls.INT16,
+            "bit": cls.BITS,
+        }
         for member in cls:
             if member.value == key:
                 return member
@@ -78,12 +84,16 @@ class ValueType(enum.Enum):
 
 def _number(value: object, hi: int, what: str) -> int:
     if isinstance(value, bool) or not isinstance(value, int):
-        raise InvalidInput(f"{what} must be a whole number, got {str(value)[:20]!r}", code="watch_bad_number")
+        raise InvalidInput(
+            f"{what} must be a whole number, got {str(value)[:20]!r}",
+            code="watch_bad_number",
+            params={"text": str(value)[:20]},
+        )
     if not 0 <= value <= hi:
         raise InvalidInput(
             f"{what} {value} is out of range (0..{hi})",
-            code="watch_out_of_range",
-            params={"what": what, "value": value, "max": hi},
+            code="watch_gv_out_of_range" if what == "GV" else "watch_register_out_of_range",
+            params={"value": value, "max": hi},
         )
     return value
 
@@ -113,9 +123,15 @@ class WatchEntry:
             n = _number(number, REGISTER_MAX - kind.count + 1, "register")
         text = str(name).strip()
         if "\n" in text or "\r" in text:
-            raise InvalidInput("a watched value's name is one line", code="watch_bad_name")
+            raise InvalidInput(
+                "a watched value's name is one line", code="watch_bad_name", params={"max": NAME_MAX}
+            )
         if len(text) > NAME_MAX:
-            raise InvalidInput(f"a watched value's name has at most {NAME_MAX} characters", code="watch_bad_name")
+            raise InvalidInput(
+                f"a watched value's name has at most {NAME_MAX} characters",
+                code="watch_bad_name",
+                params={"max": NAME_MAX},
+            )
         return cls(src, n, kind, text)
 
     @property
@@ -157,18 +173,30 @@ class WatchEntry:
             return word - 0x10000 if word >= 0x8000 else word
         return word
 
-    def encode(self, value: object, order: WordOrder) -> list[int]:
-        """The registers that hold ``value`` (refused in words: NaN, out of range, not a number)."""
+    def parse_value(self, value: object) -> float | int:
+        """``value`` (a number or its text: ``7.5``, ``-2``, ``0b101``, ``0x1F``) checked for this
+        entry's type; refused in words: NaN, out of range, not a number."""
         if self.type is ValueType.FLOAT32:
-            return encode_floats([_finite(value, self.title)], order)
+            return _finite(value, self.title)
         if self.type is ValueType.INT16:
-            number = _whole(value, self.title, -0x8000, 0x7FFF)
-            return [number & 0xFFFF]
-        return [_whole(value, self.title, 0, 0xFFFF)]
+            return _whole(value, self.title, -0x8000, 0x7FFF)
+        return _whole(value, self.title, 0, 0xFFFF)
+
+    def encode(self, value: object, order: WordOrder) -> list[int]:
+        """The registers that hold ``value`` (checked as :meth:`parse_value` does)."""
+        number = self.parse_value(value)
+        if self.type is ValueType.FLOAT32:
+            return encode_floats([float(number)], order)
+        return [int(number) & 0xFFFF]
 
     def to_dict(self) -> dict[str, object]:
         """As the project file holds it (docs/PROJECT_FORMAT.md, ``watch_list``)."""
-        return {"source": self.source.value, "number": self.number, "type": self.type.value, "name": self.name}
+        return {
+            "source": self.source.value,
+            "number": self.number,
+            "type": self.type.value,
+            "name": self.name,
+        }
 
 
 def _source(text: str) -> Source:
@@ -178,7 +206,11 @@ def _source(text: str) -> Source:
             return member
     if key in ("register", "r"):
         return Source.REGISTER
-    raise InvalidInput(f"unknown source {str(text)[:20]!r}: use gv or reg", code="watch_bad_source")
+    raise InvalidInput(
+        f"unknown source {str(text)[:20]!r}: use gv or reg",
+        code="watch_bad_source",
+        params={"source": str(text)[:20]},
+    )
 
 
 def _finite(value: object, name: str) -> float:
@@ -186,15 +218,33 @@ def _finite(value: object, name: str) -> float:
         try:
             value = float(value.strip())
         except ValueError:
-            raise InvalidInput(f"{name}: {value[:20]!r} is not a number", code="watch_not_a_number") from None
+            raise _not_a_number(name, value) from None
     if isinstance(value, bool) or not isinstance(value, int | float):
-        raise InvalidInput(f"{name}: {str(value)[:20]!r} is not a number", code="watch_not_a_number")
+        raise _not_a_number(name, value)
     number = float(value)
     if not math.isfinite(number):
-        raise InvalidInput(f"{name}: {number} is not a finite number", code="watch_not_finite")
+        raise InvalidInput(
+            f"{name}: {number} is not a finite number", code="watch_not_finite", params={"name": name}
+        )
     if abs(number) > FLOAT32_MAX:
-        raise InvalidInput(f"{name}: {number:g} does not fit a float32", code="watch_out_of_range")
+        raise InvalidInput(
+            f"{name}: {number:g} does not fit a float32",
+            code="watch_value_out_of_range",
+            params={
+                "name": name,
+                "value": f"{number:g}",
+                "min": f"{-FLOAT32_MAX:.7g}",
+                "max": f"{FLOAT32_MAX:.7g}",
+            },
+        )
     return number
+
+
+def _not_a_number(name: str, value: object) -> InvalidInput:
+    text = str(value).strip()[:20]
+    return InvalidInput(
+        f"{name}: {text!r} is not a number", code="watch_not_a_number", params={"name": name, "text": text}
+    )
 
 
 def _whole(value: object, name: str, lo: int, hi: int) -> int:
@@ -203,16 +253,16 @@ def _whole(value: object, name: str, lo: int, hi: int) -> int:
         try:
             value = int(text, 0) if text[:2] in ("0b", "0x") else int(text)
         except ValueError:
-            raise InvalidInput(f"{name}: {text[:20]!r} is not a whole number", code="watch_not_a_number") from None
+            raise _not_a_number(name, text) from None
     if isinstance(value, float) and math.isfinite(value) and value.is_integer():
         value = int(value)
     if isinstance(value, bool) or not isinstance(value, int):
-        raise InvalidInput(f"{name}: {str(value)[:20]!r} is not a whole number", code="watch_not_a_number")
+        raise _not_a_number(name, value)
     if not lo <= value <= hi:
         raise InvalidInput(
             f"{name}: {value} is out of range ({lo}..{hi})",
-            code="watch_out_of_range",
-            params={"what": name, "value": value, "max": hi},
+            code="watch_value_out_of_range",
+            params={"name": name, "value": value, "min": lo, "max": hi},
         )
     return value
 
@@ -253,5 +303,6 @@ def parse_spec(source: Source, text: str) -> WatchEntry:
         raise InvalidInput(
             f"{what} {number_text.strip()[:20]!r} is not a number (e.g. 10, 10:int16, 562:bits=alarms)",
             code="watch_bad_number",
+            params={"text": number_text.strip()[:20]},
         ) from None
     return WatchEntry.make(source, number, type_text.strip() or None, name)

@@ -63,7 +63,11 @@ def merge_blocks(entries: Sequence[WatchEntry], gap: int | None = None) -> tuple
     blocks: list[Block] = []
     for start, end in spans:
         last = blocks[-1] if blocks else None
-        if last is not None and start - last.end <= gap and max(end, last.end) - last.address <= MAX_READ_REGISTERS:
+        if (
+            last is not None
+            and start - last.end <= gap
+            and max(end, last.end) - last.address <= MAX_READ_REGISTERS
+        ):
             blocks[-1] = Block(last.address, max(end, last.end) - last.address)
         else:
             blocks.append(Block(start, end - start))

@@ -64,7 +64,7 @@ def _entry_from(item: object, index: int) -> WatchEntry:
 
 def _column(exc: InvalidInput, guess: str) -> str:
     return {"watch_bad_type": "type", "watch_bad_source": "source", "watch_bad_name": "name"}.get(
-        exc.code, "number" if exc.code in ("watch_out_of_range", "watch_bad_number") else guess
+        exc.code, "number" if exc.code.endswith("out_of_range") or exc.code == "watch_bad_number" else guess
     )
 
 
