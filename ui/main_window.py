@@ -75,11 +75,11 @@ from ui.window_actions import WindowActions
 from ui.window_cell import install_cell
 from ui.window_column import ControlColumn
 from ui.window_docks import WindowDocks
-from ui.window_watch_list import install_watch_list
 from ui.window_geometry import MIN_SIZE, default_size, restore_window
 from ui.window_rows import add_window_rows
 from ui.window_status import WindowStatusBar
 from ui.window_tabs import LazyTab
+from ui.window_watch_list import install_watch_list
 
 if TYPE_CHECKING:  # built on first show (LazyTab): not imported before the window's first paint
     from ui.panels.planner_panel import PlannerPanel

@@ -33,9 +33,9 @@ from app.protocol.enums import (
 from app.protocol.exceptions import GATEWAY_EXCEPTIONS
 from ui.joins import join_names
 from ui.messages_files import FILE_TEMPLATES, file_fields, file_text, os_problem
-from ui.messages_watch import WATCH_TEMPLATES
 from ui.messages_plan import _number, _tr, envelope_text
 from ui.messages_profile import is_profile_code, profile_text
+from ui.messages_watch import WATCH_TEMPLATES
 
 __all__ = [
     "LEVEL_ERROR",

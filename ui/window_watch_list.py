@@ -20,6 +20,7 @@ The panel itself is built when the dock is first shown (pyqtgraph with it).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from PySide6.QtCore import QEvent, QObject, Qt, Slot
@@ -62,7 +63,9 @@ class WatchListHost(QObject):
         self.entries: tuple[WatchEntry, ...] = tuple(window.project.project.watch_list)
         self.panel: WatchListPanel | None = None
         self._sent: tuple[WatchEntry, ...] | None = None  # the list the link reads now
-        self.ask_value = lambda title, label, current: _ask_value(window, title, label, current)
+        self.ask_value: Callable[[str, str, str], str | None] = lambda title, label, current: _ask_value(
+            window, title, label, current
+        )
         dock = self.dock = QDockWidget(window)
         dock.setObjectName("WatchListDock")
         placeholder = QWidget(dock)
@@ -181,7 +184,9 @@ class WatchListHost(QObject):
         last = self.history.last.get(entry)
         current = format_value(entry, last.value).replace(" ", "") if last is not None else ""
         text = self.ask_value(
-            self.tr("Write value"), self.tr("New value of {what} ({type}):").format(what=entry.title, type=entry.type.value), current
+            self.tr("Write value"),
+            self.tr("New value of {what} ({type}):").format(what=entry.title, type=entry.type.value),
+            current,
         )
         if text is None:
             return False
@@ -193,15 +198,27 @@ class WatchListHost(QObject):
         settings = self.link.settings
         where = settings.endpoint if settings is not None else "?"
         shown = format_value(entry, value)
-        question = self.tr("Write {value} to {what} ({where_reg}) on the controller at {endpoint}?\n\nIt holds {old} now.").format(
-            value=shown, what=entry.title, where_reg=entry.label, endpoint=where, old=current or self.tr("(not read)")
+        question = self.tr(
+            "Write {value} to {what} ({where_reg}) on the controller at {endpoint}?\n\nIt holds {old} now."
+        ).format(
+            value=shown,
+            what=entry.title,
+            where_reg=entry.label,
+            endpoint=where,
+            old=current or self.tr("(not read)"),
         )
         if not self.window.confirm(self.tr("Write value"), question):
             return False
         safety.session.audit.record(
             "action",
             "write watched value",
-            args={"what": entry.label, "name": entry.name, "type": entry.type.value, "value": shown, "was": current},
+            args={
+                "what": entry.label,
+                "name": entry.name,
+                "type": entry.type.value,
+                "value": shown,
+                "was": current,
+            },
         )
         panel.show_problem("")
         pending = self.link.track(self.link.submit(WriteWatched(entry, value)))
@@ -232,7 +249,10 @@ class WatchListHost(QObject):
             self.history.export_csv(path, self.entries)
         except (OSError, TeachPadError) as exc:
             dialogs.error(
-                title, self.tr("Cannot write {path}: {error}").format(path=path, error=getattr(exc, "strerror", None) or str(exc))
+                title,
+                self.tr("Cannot write {path}: {error}").format(
+                    path=path, error=getattr(exc, "strerror", None) or str(exc)
+                ),
             )
             return False
         return True

@@ -153,7 +153,7 @@ def _project_pieces(snap: ProjectSnapshot) -> Iterator[str]:
         first = False
     yield "[]" if first else "\n  ]"
     if snap.watch_list:  # optional: a project without a watch list is written as before
-        yield f',\n  {_dumps(WATCH_LIST_KEY)}: '
+        yield f",\n  {_dumps(WATCH_LIST_KEY)}: "
         yield from _json_list((_dumps(e) for e in watch_list_to_json(snap.watch_list)), "  ")
     yield "\n}\n"
 

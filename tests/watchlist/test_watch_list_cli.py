@@ -35,10 +35,10 @@ def _hold(sim: Any, order: WordOrder) -> None:
 def test_text_lines(sim_factory: Any, capsys: pytest.CaptureFixture[str], order: str) -> None:
     sim = sim_factory(word_order=WordOrder.parse(order))
     _hold(sim, WordOrder.parse(order))
+    watched = ("--gv", "10", "--gv", "11", "--reg", "40", "--reg", "41:bits", "--reg", "560")
     code, out, err = run(
-        sim.port, capsys, *ROOMY_POLL, "--word-order", order,
-        "watch", "--gv", "10", "--gv", "11", "--reg", "40", "--reg", "41:bits", "--reg", "560", "--count", "2",
-    )  # fmt: skip
+        sim.port, capsys, *ROOMY_POLL, "--word-order", order, "watch", *watched, "--count", "2"
+    )
     assert code == ExitCode.OK, err
     lines = out.splitlines()
     assert len(lines) == 2
@@ -51,7 +51,17 @@ def test_text_lines(sim_factory: Any, capsys: pytest.CaptureFixture[str], order:
 def test_json_lines_with_names(sim: Any, capsys: pytest.CaptureFixture[str]) -> None:
     _hold(sim, WordOrder.LOW_FIRST)
     code, out, err = run(
-        sim.port, capsys, *ROOMY_POLL, "watch", "--json", "--count", "1", "--gv", "10=tool length", "--reg", "40"
+        sim.port,
+        capsys,
+        *ROOMY_POLL,
+        "watch",
+        "--json",
+        "--count",
+        "1",
+        "--gv",
+        "10=tool length",
+        "--reg",
+        "40",
     )
     assert code == ExitCode.OK, err
     doc = json.loads(out.splitlines()[0])
@@ -73,7 +83,9 @@ def test_a_register_the_controller_lacks_reads_error_and_the_others_go_on(
     sim: Any, capsys: pytest.CaptureFixture[str]
 ) -> None:
     _hold(sim, WordOrder.LOW_FIRST)
-    code, out, err = run(sim.port, capsys, *ROOMY_POLL, "watch", "--count", "1", "--gv", "10", "--reg", "60000")
+    code, out, err = run(
+        sim.port, capsys, *ROOMY_POLL, "watch", "--count", "1", "--gv", "10", "--reg", "60000"
+    )
     assert code == ExitCode.OK, err
     assert out.split(" ", 1)[1].strip() == "GV10=12.5 reg60000=error"
 

@@ -48,8 +48,14 @@ def test_an_old_project_opens_with_an_empty_watch_list(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("entry", "words"),
     [
-        ({"source": "gv", "number": 40000, "type": "float32"}, "watch_list[0], field 'number': GV 40000 is out of range"),
-        ({"source": "gv", "number": 1, "type": "double"}, "watch_list[0], field 'type': unknown type 'double'"),
+        (
+            {"source": "gv", "number": 40000, "type": "float32"},
+            "watch_list[0], field 'number': GV 40000 is out of range",
+        ),
+        (
+            {"source": "gv", "number": 1, "type": "double"},
+            "watch_list[0], field 'type': unknown type 'double'",
+        ),
         ({"source": "coil", "number": 1}, "watch_list[0], field 'source': unknown source 'coil'"),
         ({"source": "reg", "number": "x"}, "watch_list[0], field 'number'"),
         ({"source": "reg", "number": 3, "name": 5}, "watch_list[0], field 'name'"),

@@ -128,7 +128,12 @@ def test_the_operator_may_not_write(qtbot: Any, sim: Any, window: Any) -> None:
 
 def test_the_engineer_writes_confirmed_and_audited(qtbot: Any, sim: Any, window: Any) -> None:
     asked: list[str] = []
-    window.confirm = lambda _title, text: asked.append(text) or True
+
+    def confirm(_title: str, text: str) -> bool:
+        asked.append(text)
+        return True
+
+    window.confirm = confirm
     host = _open(qtbot, window)
     connect(qtbot, window.link, sim)
     log_in(window, Role.ENGINEER)

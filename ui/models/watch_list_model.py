@@ -52,7 +52,9 @@ class WatchListModel(QAbstractTableModel):
     def refresh_values(self) -> None:
         if self._entries:
             self.dataChanged.emit(
-                self.index(0, COL_VALUE), self.index(len(self._entries) - 1, COL_AGE), [Qt.ItemDataRole.DisplayRole]
+                self.index(0, COL_VALUE),
+                self.index(len(self._entries) - 1, COL_AGE),
+                [Qt.ItemDataRole.DisplayRole],
             )
 
     # --- QAbstractTableModel
@@ -62,7 +64,9 @@ class WatchListModel(QAbstractTableModel):
     def columnCount(self, parent: _Index = QModelIndex()) -> int:  # noqa: B008
         return 0 if parent.isValid() else 5
 
-    def headerData(self, section: int, orientation: Qt.Orientation, role: int = Qt.ItemDataRole.DisplayRole) -> Any:
+    def headerData(
+        self, section: int, orientation: Qt.Orientation, role: int = Qt.ItemDataRole.DisplayRole
+    ) -> Any:
         if orientation != Qt.Orientation.Horizontal or role != Qt.ItemDataRole.DisplayRole:
             return None
         if not 0 <= section < 5:
@@ -92,7 +96,11 @@ class WatchListModel(QAbstractTableModel):
         if column == COL_NAME:
             return entry.name
         if column == COL_WHERE:
-            return f"GV{entry.number}" if entry.source is Source.GV else self.tr("reg {n}").format(n=entry.number)
+            return (
+                f"GV{entry.number}"
+                if entry.source is Source.GV
+                else self.tr("reg {n}").format(n=entry.number)
+            )
         if column == COL_TYPE:
             return {ValueType.FLOAT32: "float32", ValueType.INT16: "int16", ValueType.BITS: self.tr("bits")}[
                 entry.type

@@ -39,9 +39,9 @@ from PySide6.QtWidgets import (
 from app.errors import InvalidInput
 from app.watchlist.entry import GV_MAX, MAX_ENTRIES, REGISTER_MAX, Source, ValueType, WatchEntry
 from app.watchlist.history import WatchHistory
+from ui.messages import error_text
 from ui.models.watch_list_model import COL_NAME, COL_VALUE, COL_WHERE, WatchListModel
 from ui.palette import COLOR_ERROR
-from ui.messages import error_text
 
 if TYPE_CHECKING:  # imported when the plot is built
     import pyqtgraph as pg
@@ -57,9 +57,9 @@ _COLORS = ("#1565c0", "#c62828", "#2e7d32", "#ef8f00", "#6a1b9a", "#00838f", "#5
 class WatchListPanel(QWidget):
     """See the module docstring."""
 
-    entriesEdited = Signal(tuple)  # noqa: N815 - tuple[WatchEntry, ...]: the list as the operator made it
-    writeRequested = Signal(object)  # noqa: N815 - WatchEntry: write a value to it (an engineer)
-    exportRequested = Signal()  # noqa: N815
+    entriesEdited = Signal(tuple)
+    writeRequested = Signal(object)
+    exportRequested = Signal()
 
     def __init__(self, history: WatchHistory, fresh: Any, parent: QWidget | None = None) -> None:
         super().__init__(parent)
@@ -172,7 +172,9 @@ class WatchListPanel(QWidget):
     # --- the operator's edits
     def entry_from_fields(self) -> WatchEntry:
         source = self.source_box.currentData()
-        return WatchEntry.make(source, self.number_box.value(), self.type_box.currentData(), self.name_edit.text())
+        return WatchEntry.make(
+            source, self.number_box.value(), self.type_box.currentData(), self.name_edit.text()
+        )
 
     @Slot()
     def add_from_fields(self) -> None:
@@ -218,7 +220,9 @@ class WatchListPanel(QWidget):
     def _on_source(self, _index: int) -> None:
         source = self.source_box.currentData()
         self.number_box.setRange(0, GV_MAX if source is Source.GV else REGISTER_MAX)
-        self.type_box.setCurrentIndex(self.type_box.findData(ValueType.FLOAT32 if source is Source.GV else ValueType.INT16))
+        self.type_box.setCurrentIndex(
+            self.type_box.findData(ValueType.FLOAT32 if source is Source.GV else ValueType.INT16)
+        )
 
     @Slot()
     def _update_buttons(self) -> None:
@@ -230,7 +234,9 @@ class WatchListPanel(QWidget):
         elif not self._writable:
             self.write_button.setToolTip(self.tr("Not connected, or monitor-only: nothing can be written"))
         else:
-            self.write_button.setToolTip(self.tr("Write a value to the selected GV or register (confirmed, audited)"))
+            self.write_button.setToolTip(
+                self.tr("Write a value to the selected GV or register (confirmed, audited)")
+            )
         self.export_button.setEnabled(bool(self.model.entries))
 
     # --- the clock: values, ages, plot
@@ -279,7 +285,9 @@ class WatchListPanel(QWidget):
         plot.setObjectName("WatchPlot")
         style_plot(plot)
         plot.setXRange(-PLOT_WINDOW, 0, padding=0)
-        plot.getPlotItem().addLegend(offset=(-4, 2), labelTextColor="#263238", brush=pg.mkBrush(255, 255, 255, 150))
+        plot.getPlotItem().addLegend(
+            offset=(-4, 2), labelTextColor="#263238", brush=pg.mkBrush(255, 255, 255, 150)
+        )
         layout = self.plot_host.layout()
         if layout is not None:
             layout.addWidget(plot)
@@ -307,9 +315,14 @@ class WatchListPanel(QWidget):
         self.source_box.setItemText(1, self.tr("Register"))
         for i, text in enumerate((self.tr("float32"), self.tr("int16"), self.tr("bits"))):
             self.type_box.setItemText(i, text)
-        self.source_box.setToolTip(self.tr("A GV (two registers, 2n and 2n+1) or a holding register by its address"))
+        self.source_box.setToolTip(
+            self.tr("A GV (two registers, 2n and 2n+1) or a holding register by its address")
+        )
         self.type_box.setToolTip(
-            self.tr("float32: two registers in the register profile's word order; int16: one register, signed; bits: one register as 16 bits")
+            self.tr(
+                "float32: two registers in the register profile's word order; "
+                "int16: one register, signed; bits: one register as 16 bits"
+            )
         )
         self.name_edit.setPlaceholderText(self.tr("Name (optional)"))
         self.add_button.setText(self.tr("Add"))
