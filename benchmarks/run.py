@@ -1,6 +1,7 @@
 """`make bench`: run every benchmark and print one JSON object.
 
-Usage: python -m benchmarks.run [--quick] [--long] [--only core,gui,points,noisy_line,bundle,gateway]
+Usage: python -m benchmarks.run [--quick] [--long]
+       [--only core,gui,points,noisy_line,bundle,gateway,watch_list]
 
 ``goals`` (:mod:`benchmarks.goals`) prints each of the issue's figures beside its goal.
 ``--long`` adds the 10-minute memory soak (``gui.memory.soak``).
@@ -82,6 +83,12 @@ def _gateway(args: argparse.Namespace) -> dict[str, Any]:
     return guarded("gateway", lambda: gateway.run(args.quick))
 
 
+def _watch_list(args: argparse.Namespace) -> dict[str, Any]:
+    """The watch list's poll budget and cost beside the pose poll alone (issue 24)."""
+    watch_list = __import__("benchmarks.watch_list", fromlist=["run"])
+    return guarded("watch_list", lambda: watch_list.run(args.quick))
+
+
 #: The suites in the order they run; each imported only when it runs.
 SUITES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
     "core": _core,
@@ -91,6 +98,7 @@ SUITES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
     "bundle": _bundle,
     "safety": _safety,
     "gateway": _gateway,
+    "watch_list": _watch_list,
 }
 
 
@@ -99,7 +107,9 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--quick", action="store_true", help="small N and short windows")
     parser.add_argument("--long", action="store_true", help="memory soak of 10 minutes (RSS every 30 s)")
     parser.add_argument(
-        "--only", default="core,gui,points,noisy_line,bundle,gateway", help="comma-separated suites"
+        "--only",
+        default="core,gui,points,noisy_line,bundle,gateway,watch_list",
+        help="comma-separated suites",
     )
     parser.add_argument(
         "--no-compile",

@@ -9,8 +9,9 @@ The poll budget (named here, read at use time, so tests and benchmarks may chang
   block again once :data:`SLOW_PERIOD` has passed since its last read.
 
 An empty list costs nothing: no read, no publish. Registers closer than :data:`MERGE_GAP` are
-read in one request (a few registers more cost less than a second round trip); a block never
-exceeds :data:`~app.protocol.registers.MAX_READ_REGISTERS`. Qt-free.
+read in one request (a few registers more cost less than a second round trip; the slow lane,
+read rarely, merges over :data:`SLOW_MERGE_GAP`); a block never exceeds
+:data:`~app.protocol.registers.MAX_READ_REGISTERS`. Qt-free.
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ __all__ = [
     "FAST_READS",
     "FAST_REGISTERS",
     "MERGE_GAP",
+    "SLOW_MERGE_GAP",
     "SLOW_PERIOD",
     "SLOW_READS_PER_POLL",
     "Block",
@@ -41,7 +43,8 @@ FAST_READS = 1  # reads per poll for the fast lane
 FAST_REGISTERS = 64  # registers per poll for the fast lane
 SLOW_PERIOD = 0.5  # s between two reads of one slow block
 SLOW_READS_PER_POLL = 1
-MERGE_GAP = 8  # registers between two spans read in one request rather than two
+MERGE_GAP = 8  # registers between two spans read in one request rather than two (fast lane)
+SLOW_MERGE_GAP = 32  # the same for the slow lane: read rarely, fewer and longer requests
 
 
 @dataclass(frozen=True, slots=True)
@@ -95,7 +98,7 @@ class ReadPlan:
                 fast.append(entry)
             else:
                 rest.append(entry)
-        return cls(tuple(entries), merge_blocks(fast), merge_blocks(rest))
+        return cls(tuple(entries), merge_blocks(fast), merge_blocks(rest, SLOW_MERGE_GAP))
 
     @property
     def empty(self) -> bool:

@@ -87,7 +87,8 @@ def test_each_operation_says_its_priority_class_and_coalescing() -> None:
     assert motion == {JogPress, SetJogRatio, Step, GoZero, RunProgram, MoveToPoint, UploadPoints}
     assert (JogPress.coalesce, SetJogRatio.coalesce) == (JOG_PRESS, JOG_RATIO)
     assert set(JogRelease.cancels) == {JOG_PRESS, JOG_RATIO}
-    assert {type(op) for op in EVERY_OP if not op.needs_link} == {Stop, JogRelease, CancelUpload, SetWatchList}
+    no_link = {Stop, JogRelease, CancelUpload, SetWatchList}
+    assert {type(op) for op in EVERY_OP if not op.needs_link} == no_link
     assert {type(op) for op in EVERY_OP if op.tracks_motion} == {Step, GoZero, RunProgram, MoveToPoint}
 
 
