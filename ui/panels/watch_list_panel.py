@@ -95,6 +95,7 @@ class WatchListPanel(QWidget):
         self.message.setObjectName("WatchMessage")
         self.message.setStyleSheet(f"color: {COLOR_ERROR};")
         self.message.setWordWrap(True)
+        self.message.hide()  # shown with a problem only
 
         self.view = QTableView(self)
         self.view.setObjectName("WatchTable")
@@ -286,7 +287,12 @@ class WatchListPanel(QWidget):
         style_plot(plot)
         plot.setXRange(-PLOT_WINDOW, 0, padding=0)
         plot.getPlotItem().addLegend(
-            offset=(-4, 2), labelTextColor="#263238", brush=pg.mkBrush(255, 255, 255, 150)
+            offset=(-4, 2),
+            colCount=3,
+            labelTextColor="#263238",
+            brush=pg.mkBrush(255, 255, 255, 150),
+            verSpacing=-6,
+            horSpacing=8,
         )
         layout = self.plot_host.layout()
         if layout is not None:
@@ -300,6 +306,8 @@ class WatchListPanel(QWidget):
         super().showEvent(event)
         if self._plot is None:
             self._build_plot()
+            width = max(self.width(), 400)
+            self.splitter.setSizes([width * 3 // 5, width * 2 // 5])
         self.timer.start()
 
     def hideEvent(self, event: Any) -> None:
