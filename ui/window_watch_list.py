@@ -28,7 +28,7 @@ from PySide6.QtWidgets import QDockWidget, QWidget
 
 from app.errors import InvalidInput, TeachPadError
 from app.link.ops import SetWatchList, WriteWatched
-from app.link.types import ConnectionState, WorkerError
+from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult
 from app.safety.roles import Action
 from app.watchlist.entry import WatchEntry, format_value
@@ -154,8 +154,9 @@ class WatchListHost(QObject):
         wanted = self.entries if self.open else ()
         if wanted == self._sent:
             return
-        if not wanted and self._sent is None:
-            return  # nothing was ever sent: the link reads no list (and no worker is made for it)
+        if self._sent is None and (not wanted or self.link.connection.state is LinkState.DISCONNECTED):
+            return  # nothing sent yet: no list to clear, or no link (sent when it connects: the
+            # window's start makes no worker for it)
         self.generation += 1
         self._sent = wanted
         self.link.submit(SetWatchList(wanted, generation=self.generation))
@@ -167,6 +168,7 @@ class WatchListHost(QObject):
 
     @Slot(object)
     def _on_connection(self, _state: ConnectionState) -> None:
+        self._send()
         if self.panel is not None:
             self.panel.set_writable(self.link.state.writable)
 

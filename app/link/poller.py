@@ -3,7 +3,9 @@
 Order of a poll: a stop the controller has not confirmed goes out again first
 (:meth:`~app.link.jog.JogMachine.settle_halt`); then **status first, then pose** -- so when the
 status says a motion ended, the pose read after it is the final one -- with the urgent jobs run
-between the two reads, the jog guard and the halt watch seeing the pose at once. The poller
+between the two reads, the jog guard and the halt watch seeing the pose at once; after the pose,
+the watch list's reads when it has entries (:mod:`app.link.watch_list`; none at all for an empty
+list), the urgent jobs once more after them. The poller
 returns what the poll read (:class:`Polled`, or :class:`PollFailed`) and
 :func:`app.link.sequence.poll` hands it on, in this order: one ``publish_polled`` of the pose /
 status / alarms (each only on change) and of the good poll, the restart canary (the supervisor),
