@@ -208,3 +208,14 @@ def test_the_table_model_is_sound(qtmodeltester: Any, qtbot: Any, window: Any) -
     host = _open(qtbot, window)
     host.set_entries((GV10, REG40))
     qtmodeltester.check(host.panel.model)
+
+
+def test_the_same_value_twice_is_said_and_remove_takes_one_out(qtbot: Any, window: Any) -> None:
+    host = _open(qtbot, window)
+    _add(host, Source.GV, 10, "tool length")
+    _add(host, Source.GV, 10, "again")
+    assert "GV10 is in the list already" in host.panel.message.text()
+    assert window.project.project.watch_list == (GV10,)
+    host.panel.select_row(0)
+    host.panel.remove_button.click()
+    assert window.project.project.watch_list == () and host.panel.model.entries == ()
