@@ -7,11 +7,14 @@ alone, interleaved in thirds so machine noise hits all alike:
 * ``pose_poll_alone``: status + pose (what a poll costs with an empty watch list: the poller
   reads nothing more, ``watch_list_poll_cost_ms.entries_0``);
 * ``entries_10``: ten GVs together (GV10..GV19: one block, the fast lane, every poll);
-* ``entries_50``: fifty GVs spread over GV0..GV490 (the fast lane holds the first, the rest
-  are read one block per poll on the slow clock, each block every
+* ``entries_50``: fifty GVs spread over GV0..GV490 (seven inside the pose and status blocks are
+  decoded from the poll's own reads; the fast lane holds the first of the others, the rest are
+  read one block per poll on the slow clock, each block every
   :data:`app.watchlist.plan.SLOW_PERIOD` s).
 
-``watch_list_poll_cost_ms``: the mean cycle minus the pose poll alone's, per list; ``budget``: the
+``watch_list_poll_cost_ms``: the median cycle minus the pose poll alone's, per list (and the same
+of the means, ``_mean``); ``ratio_vs_pose_alone``: the medians' ratio (one extra read beside the
+poll's two: about 1.5x expected); ``budget``: the
 plan's figures (fast lane reads and registers, slow blocks, the slow refresh at 50 Hz polling).
 """
 
@@ -32,6 +35,8 @@ from app.timing import POLL_HZ_DEFAULT
 from app.watchlist import plan as budget
 from app.watchlist.entry import Source, WatchEntry
 from app.watchlist.plan import ReadPlan
+
+ROUNDS = 30  # turns of each cycle, interleaved
 
 LISTS: dict[str, tuple[WatchEntry, ...]] = {
     "entries_10": tuple(WatchEntry.make(Source.GV, n) for n in range(10, 20)),
@@ -66,6 +71,7 @@ def _budget(entries: tuple[WatchEntry, ...]) -> dict[str, Any]:
     slow = len(plan.slow)
     period = 1.0 / POLL_HZ_DEFAULT
     return {
+        "served_by_the_poll_reads": len(plan.served),
         "fast_entries": len(plan.fast_entries()),
         "fast_reads": len(plan.fast),
         "fast_registers": sum(b.count for b in plan.fast),
@@ -77,7 +83,9 @@ def _budget(entries: tuple[WatchEntry, ...]) -> dict[str, Any]:
 
 
 def bench(sim: SimController, seconds: float) -> dict[str, Any]:
-    client = RobotClient(ConnectionSettings(host="127.0.0.1", port=sim.port))
+    # a roomy poll timeout: the simulator answers from this process, which a loaded machine holds
+    # past the product's 0.15 s; this measures what a poll costs, not silence
+    client = RobotClient(ConnectionSettings(host="127.0.0.1", port=sim.port, poll_timeout=1.0))
     client.connect()
     timeout = client.settings.effective_poll_timeout
     readers: dict[str, WatchListReader] = {}
@@ -102,18 +110,20 @@ def bench(sim: SimController, seconds: float) -> dict[str, Any]:
     try:
         for fn in cycles.values():
             _cycles(fn, 0.2)  # warm
-        for _ in range(3):
+        for _ in range(ROUNDS):  # short turns, so machine noise hits all alike
             for name, fn in cycles.items():
-                runs[name].append(_cycles(fn, seconds / 3))
+                runs[name].append(_cycles(fn, seconds / ROUNDS))
     finally:
         client.close()
     out: dict[str, Any] = {name: _figures(r) for name, r in runs.items()}
-    alone = out["pose_poll_alone"]["mean_ms"]
+    alone = out["pose_poll_alone"]
     out["watch_list_poll_cost_ms"] = {"entries_0": 0.0}
     for name, entries in LISTS.items():
-        out[name]["ratio_vs_pose_alone"] = out[name]["mean_ms"] / alone
+        # the medians: a loaded machine's stalls land in the means of whichever cycle they hit
+        out[name]["ratio_vs_pose_alone"] = out[name]["p50_ms"] / alone["p50_ms"]
         out[name]["budget"] = _budget(entries)
-        out["watch_list_poll_cost_ms"][name] = out[name]["mean_ms"] - alone
+        out["watch_list_poll_cost_ms"][name] = out[name]["p50_ms"] - alone["p50_ms"]
+        out["watch_list_poll_cost_ms"][f"{name}_mean"] = out[name]["mean_ms"] - alone["mean_ms"]
     out["budget"] = {
         "fast_reads": budget.FAST_READS,
         "fast_registers": budget.FAST_REGISTERS,

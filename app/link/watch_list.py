@@ -21,8 +21,8 @@ from app.link.ops import Handlers, SetWatchList, WriteWatched
 from app.models import CommandResult
 from app.protocol import registers
 from app.watchlist import plan as budget
-from app.watchlist.entry import WatchEntry, format_value
-from app.watchlist.plan import Block, ReadPlan, WatchReadings, read_blocks
+from app.watchlist.entry import WatchEntry, WatchValue, format_value
+from app.watchlist.plan import POLL_BLOCKS, Block, ReadPlan, WatchReadings, decode_block, read_blocks
 
 __all__ = ["WatchListReader"]
 
@@ -53,11 +53,13 @@ class WatchListReader:
         self._slow_read_at = {}
 
     def read(self, client: RobotClient, timeout: float) -> WatchReadings | None:
-        """The fast lane and at most :data:`~app.watchlist.plan.SLOW_READS_PER_POLL` slow blocks
-        that are due (the least recently read first); None for an empty list."""
+        """The entries inside the poll's own reads (decoded from them: no read), the fast lane and
+        at most :data:`~app.watchlist.plan.SLOW_READS_PER_POLL` slow blocks that are due (the least
+        recently read first); None for an empty list."""
         plan = self.plan
         if plan.empty:
             return None
+        served = self._served(client) if plan.served else []
         blocks = list(plan.fast)
         now = time.monotonic()
         due = sorted(
@@ -67,11 +69,21 @@ class WatchListReader:
         for block in due:
             self._slow_read_at[block] = now
         blocks.extend(due)
-        if not blocks:
+        if not blocks and not served:
             return None
         with client.io_timeout(timeout):  # the poll's timeout, not the command's
             values = read_blocks(client.read_registers, blocks, plan.entries, client.settings.word_order)
-        return WatchReadings(self.generation, tuple(values))
+        return WatchReadings(self.generation, (*served, *values))
+
+    def _served(self, client: RobotClient) -> list[WatchValue]:
+        """The entries inside the status and pose blocks this poll has just read."""
+        now = time.monotonic()
+        order = client.settings.word_order
+        values: list[WatchValue] = []
+        for block, regs in zip(POLL_BLOCKS, (client.status_registers, client.pose_registers), strict=True):
+            if regs is not None:
+                values.extend(decode_block(block, regs, self.plan.served, order, now))
+        return values
 
     def publish(self, readings: WatchReadings) -> None:
         self._publish(readings)

@@ -22,19 +22,27 @@ from dataclasses import dataclass
 
 from app.errors import ModbusExceptionError
 from app.protocol.codec import WordOrder
-from app.protocol.registers import MAX_READ_REGISTERS
+from app.protocol.registers import (
+    MAX_READ_REGISTERS,
+    POSE_BLOCK_COUNT,
+    POSE_BLOCK_START,
+    STATUS_BLOCK_COUNT,
+    STATUS_BLOCK_START,
+)
 from app.watchlist.entry import WatchEntry, WatchValue
 
 __all__ = [
     "FAST_READS",
     "FAST_REGISTERS",
     "MERGE_GAP",
+    "POLL_BLOCKS",
     "SLOW_MERGE_GAP",
     "SLOW_PERIOD",
     "SLOW_READS_PER_POLL",
     "Block",
     "ReadPlan",
     "WatchReadings",
+    "decode_block",
     "merge_blocks",
     "read_blocks",
 ]
@@ -57,6 +65,10 @@ class Block:
     @property
     def end(self) -> int:
         return self.address + self.count
+
+
+#: The poll's own reads (status 560..583, pose 412..511): an entry inside them costs no read.
+POLL_BLOCKS = (Block(STATUS_BLOCK_START, STATUS_BLOCK_COUNT), Block(POSE_BLOCK_START, POSE_BLOCK_COUNT))
 
 
 def merge_blocks(entries: Sequence[WatchEntry], gap: int | None = None) -> tuple[Block, ...]:
@@ -83,29 +95,35 @@ def _fits(blocks: Sequence[Block]) -> bool:
 
 @dataclass(frozen=True)
 class ReadPlan:
-    """A watch list's reads: ``fast`` every poll, ``slow`` on the slow clock."""
+    """A watch list's reads: ``served`` by the poll's own status and pose reads (no read of its
+    own), ``fast`` every poll, ``slow`` on the slow clock."""
 
     entries: tuple[WatchEntry, ...]
     fast: tuple[Block, ...]
     slow: tuple[Block, ...]
+    served: tuple[WatchEntry, ...] = ()
 
     @classmethod
     def of(cls, entries: Sequence[WatchEntry]) -> ReadPlan:
+        served: list[WatchEntry] = []
         fast: list[WatchEntry] = []
         rest: list[WatchEntry] = []
         for entry in entries:  # list order: the first entries get the fast lane
-            if not rest and _fits(merge_blocks([*fast, entry])):
+            if any(_inside(entry, b) for b in POLL_BLOCKS):
+                served.append(entry)
+            elif not rest and _fits(merge_blocks([*fast, entry])):
                 fast.append(entry)
             else:
                 rest.append(entry)
-        return cls(tuple(entries), merge_blocks(fast), merge_blocks(rest, SLOW_MERGE_GAP))
+        return cls(tuple(entries), merge_blocks(fast), merge_blocks(rest, SLOW_MERGE_GAP), tuple(served))
 
     @property
     def empty(self) -> bool:
         return not self.entries
 
     def fast_entries(self) -> tuple[WatchEntry, ...]:
-        return tuple(e for e in self.entries if any(_inside(e, b) for b in self.fast))
+        """The entries read in every poll (the served ones included)."""
+        return tuple(e for e in self.entries if e in self.served or any(_inside(e, b) for b in self.fast))
 
 
 def _inside(entry: WatchEntry, block: Block) -> bool:
@@ -132,15 +150,24 @@ def read_blocks(
     other failure (the link) is raised."""
     values: list[WatchValue] = []
     for block in blocks:
-        inside = [e for e in entries if _inside(e, block)]
         try:
             regs = read(block.address, block.count)
         except ModbusExceptionError as exc:
             now = time.monotonic()
-            values.extend(WatchValue(e, None, (), now, str(exc)) for e in inside)
+            values.extend(WatchValue(e, None, (), now, str(exc)) for e in entries if _inside(e, block))
             continue
-        now = time.monotonic()
-        for entry in inside:
-            raw = tuple(regs[entry.address - block.address : entry.address - block.address + entry.count])
-            values.append(WatchValue(entry, entry.decode(raw, order), raw, now))
+        values.extend(decode_block(block, regs, entries, order, time.monotonic()))
+    return values
+
+
+def decode_block(
+    block: Block, regs: Sequence[int], entries: Sequence[WatchEntry], order: WordOrder, read_at: float
+) -> list[WatchValue]:
+    """The values of the ``entries`` inside ``block``, from its registers ``regs``."""
+    values: list[WatchValue] = []
+    for entry in entries:
+        if _inside(entry, block):
+            start = entry.address - block.address
+            raw = tuple(regs[start : start + entry.count])
+            values.append(WatchValue(entry, entry.decode(raw, order), raw, read_at))
     return values

@@ -155,3 +155,29 @@ def test_control_registers_are_not_written_from_the_watch_list(qtbot: Any, sim: 
         link.submit(WriteWatched(WatchEntry.make(Source.REGISTER, 440), 1))
     assert "440..445" in blocker.args[0].message
     assert sim.writes == []
+
+
+def test_values_inside_the_polls_own_reads_cost_no_read(sim: Any, make_client: Any) -> None:
+    """The mode and alarm registers (status block) and the live X (pose block) are decoded from the
+    poll's own reads: the watch list sends nothing more for them."""
+    from typing import cast
+
+    from app.link.watch_list import WatchListReader
+
+    mode = WatchEntry.make(Source.REGISTER, 560)
+    alarms = WatchEntry.make(Source.REGISTER, 562, ValueType.BITS)
+    x = WatchEntry.make(Source.GV, 206)
+    reader = WatchListReader(cast(Any, None), lambda _readings: None)
+    reader.set_list(SetWatchList((mode, x, alarms, GV10)))
+    assert set(reader.plan.served) == {mode, x, alarms}
+    client = make_client(sim)
+    client.read_status(timeout=1.0)
+    client.read_pose(timeout=1.0)
+    before = sim.requests_count
+    readings = reader.read(client, 1.0)
+    assert readings is not None
+    assert sim.requests_count == before + 1  # GV10's read only
+    got = {v.entry: v.value for v in readings.values}
+    state = sim.state()
+    assert got[mode] == int(state.mode) and got[alarms] == int(state.alarms)
+    assert got[x] == pytest.approx(state.pose[0], abs=1e-3)

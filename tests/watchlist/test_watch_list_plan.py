@@ -79,8 +79,11 @@ def test_the_first_entries_get_the_fast_lane_the_rest_the_slow_one() -> None:
     ten = tuple(WatchEntry.make(Source.GV, n) for n in range(10, 20))
     plan = ReadPlan.of(ten)
     assert plan.slow == () and plan.fast_entries() == ten
-    spread = tuple(WatchEntry.make(Source.GV, n) for n in range(0, 500, 10))
+    spread = tuple(WatchEntry.make(Source.GV, n) for n in range(300, 800, 10))  # none in the poll's reads
     plan = ReadPlan.of(spread)
     assert len(plan.fast) == budget.FAST_READS and plan.fast_entries() == spread[:1]
     assert 0 < len(plan.slow) < len(spread) - 1  # the slow lane reads several GVs per request
+    live = (WatchEntry.make(Source.GV, 206), WatchEntry.make(Source.REGISTER, 561))  # X, program state
+    plan = ReadPlan.of((*live, *spread))
+    assert plan.served == live and plan.fast_entries()[:3] == (*live, spread[0])
     assert ReadPlan.of(()).empty
