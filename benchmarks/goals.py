@@ -171,6 +171,31 @@ GOALS: tuple[tuple[str, float | None, str, str], ...] = (
         "/s",
         "cell view: polls answered per s, all 16 (320 = every poller at 20 Hz; report only)",
     ),
+    # issue 24: the watch list's cost in a poll (benchmarks.watch_list), beside the pose poll alone
+    (
+        "watch_list.entries_10.ratio_vs_pose_alone",
+        1.75,
+        "x",
+        "poll cycle with 10 watched GVs (one fast-lane read) vs the pose poll alone (medians)",
+    ),
+    (
+        "watch_list.entries_50.ratio_vs_pose_alone",
+        2.0,
+        "x",
+        "poll cycle with 50 watched GVs (poll reads + fast + slow lane) vs the pose poll alone (medians)",
+    ),
+    (
+        "watch_list.watch_list_poll_cost_ms.entries_10",
+        None,
+        " ms",
+        "what 10 watched GVs add to a poll (report only)",
+    ),
+    (
+        "watch_list.watch_list_poll_cost_ms.entries_50",
+        None,
+        " ms",
+        "what 50 watched GVs add to a poll (report only)",
+    ),
     ("bundle.size_mb", None, " MB", "the bundle (make dist) on disk (report only)"),
     ("bundle.cli_status_s.ratio_bundle_vs_venv", None, "x", "CLI status run: bundle vs venv (report only)"),
 )

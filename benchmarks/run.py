@@ -90,6 +90,12 @@ def _cell_view(args: argparse.Namespace) -> dict[str, Any]:
     return guarded("cell_view", lambda: cell_view.run(args.quick))
 
 
+def _watch_list(args: argparse.Namespace) -> dict[str, Any]:
+    """The watch list's poll budget and cost beside the pose poll alone (issue 24)."""
+    watch_list = __import__("benchmarks.watch_list", fromlist=["run"])
+    return guarded("watch_list", lambda: watch_list.run(args.quick))
+
+
 #: The suites in the order they run; each imported only when it runs.
 SUITES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
     "core": _core,
@@ -100,6 +106,7 @@ SUITES: dict[str, Callable[[argparse.Namespace], dict[str, Any]]] = {
     "safety": _safety,
     "gateway": _gateway,
     "cell_view": _cell_view,
+    "watch_list": _watch_list,
 }
 
 
@@ -109,7 +116,7 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--long", action="store_true", help="memory soak of 10 minutes (RSS every 30 s)")
     parser.add_argument(
         "--only",
-        default="core,gui,points,noisy_line,bundle,gateway,cell_view",
+        default="core,gui,points,noisy_line,bundle,gateway,cell_view,watch_list",
         help="comma-separated suites",
     )
     parser.add_argument(

@@ -80,6 +80,7 @@ from ui.window_geometry import MIN_SIZE, default_size, restore_window
 from ui.window_rows import add_window_rows
 from ui.window_status import WindowStatusBar
 from ui.window_tabs import LazyTab
+from ui.window_watch_list import install_watch_list
 
 if TYPE_CHECKING:  # built on first show (LazyTab): not imported before the window's first paint
     from ui.panels.planner_panel import PlannerPanel
@@ -199,6 +200,7 @@ class MainWindow(QMainWindow):
         self.run_controller.audit = self.safety_menu.safety.session.audit  # a run's own pause (issue 19)
         self.cell = install_cell(self)  # File → Open cell…, the Cell tab (issue 23)
         self.register_map_check = install_register_map_check(self)  # Help → register map (issue 24)
+        self.watch_list = install_watch_list(self)  # View → Watch list (issue 24)
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])

@@ -35,6 +35,7 @@ from ui.joins import join_names
 from ui.messages_files import FILE_TEMPLATES, file_fields, file_text, os_problem
 from ui.messages_plan import _number, _tr, envelope_text
 from ui.messages_profile import is_profile_code, profile_text
+from ui.messages_watch import WATCH_TEMPLATES
 
 __all__ = [
     "LEVEL_ERROR",
@@ -254,6 +255,7 @@ _TEMPLATES: dict[str, str] = {
 }
 
 _TEMPLATES.update(FILE_TEMPLATES)  # refused values and files (ui/messages_files.py)
+_TEMPLATES.update(WATCH_TEMPLATES)  # the watch list (ui/messages_watch.py)
 
 # A reason whose arguments lack a placeholder of the full sentence uses this one.
 _BARE: dict[str, str] = {

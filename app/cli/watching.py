@@ -25,6 +25,7 @@ from typing import Any
 from app.cli.context import CliContext
 from app.cli.exit_codes import LINK_ERRORS, ExitCode
 from app.cli.format import format_watch_line, parse_positive_float, status_to_dict
+from app.cli.watch_list_cmd import add_watch_list_arguments, watch_list_entries, watch_list_line
 from app.errors import LinkError, ResponseTimeout, TeachPadError
 
 __all__ = ["DOWN_AFTER_DEFAULT", "WATCH_RATE_DEFAULT", "add_watch_parser", "cmd_watch"]
@@ -57,6 +58,7 @@ def add_watch_parser(sub: Any) -> None:
         help="a missed poll prints a stale line and the watch goes on; exit 3 when nothing has "
         "answered for S seconds or the connection cannot be opened again (default %(default)g)",
     )
+    add_watch_list_arguments(p)  # --gv / --reg: the watch list instead of the pose
     p.set_defaults(handler=cmd_watch)
 
 
@@ -66,6 +68,8 @@ def _link_down(error: TeachPadError) -> bool:
 
 
 def _sample_line(ctx: CliContext, elapsed: float) -> str:
+    if watch_list_entries(ctx.args):
+        return watch_list_line(ctx, elapsed)
     client = ctx.client
     timeout = ctx.settings.effective_poll_timeout
     status = client.read_status(timeout=timeout)

@@ -35,10 +35,12 @@ from typing import Any, ClassVar, TypeVar
 from app.link.types import JogRequest, Operation, StepFrame
 from app.protocol import registers
 from app.protocol.enums import ProgramMotionMode, TeachFrame, WorkMode
+from app.watchlist.entry import WatchEntry
 
 __all__ = [
     "JOG_PRESS",
     "JOG_RATIO",
+    "WATCH_LIST",
     "CancelUpload",
     "CreatePoint",
     "GoZero",
@@ -54,14 +56,17 @@ __all__ = [
     "RunProgram",
     "SetJogRatio",
     "SetMode",
+    "SetWatchList",
     "Step",
     "Stop",
     "UploadItem",
     "UploadPoints",
+    "WriteWatched",
 ]
 
 JOG_PRESS = "jog press"  # coalesce key of the jog press
 JOG_RATIO = "jog ratio"  # coalesce key of the live jog speed
+WATCH_LIST = "watch list"  # coalesce key of the watch list (the newest list is the one read)
 
 
 class JobKind(enum.Enum):
@@ -275,6 +280,34 @@ class ReadRegisters(LinkOp):
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "blocks", tuple((int(a), int(n)) for a, n in self.blocks))
+
+
+@dataclass(frozen=True)
+class SetWatchList(LinkOp):
+    """The GVs and registers the poller reads after the pose (app/watchlist/plan.py: the fast
+    lane every poll, the rest on a slower clock); empty: none, at no cost. ``generation`` is
+    carried by every reading of this list (the caller tells old readings from new ones)."""
+
+    operation: ClassVar[str] = "watch list"
+    coalesce: ClassVar[str | None] = WATCH_LIST
+    needs_link: ClassVar[bool] = False
+
+    entries: tuple[WatchEntry, ...]
+    generation: int = 0
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "entries", tuple(self.entries))
+
+
+@dataclass(frozen=True)
+class WriteWatched(LinkOp):
+    """An engineer's write of one watched value (through the client's one write guard: refused
+    in monitor-only mode, recorded in the audit trail), read back after."""
+
+    operation: ClassVar[str] = "write watched value"
+
+    entry: WatchEntry
+    value: float | int
 
 
 _Op = TypeVar("_Op", bound=LinkOp)

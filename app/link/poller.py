@@ -3,7 +3,9 @@
 Order of a poll: a stop the controller has not confirmed goes out again first
 (:meth:`~app.link.jog.JogMachine.settle_halt`); then **status first, then pose** -- so when the
 status says a motion ended, the pose read after it is the final one -- with the urgent jobs run
-between the two reads, the jog guard and the halt watch seeing the pose at once. The poller
+between the two reads, the jog guard and the halt watch seeing the pose at once; after the pose,
+the watch list's reads when it has entries (:mod:`app.link.watch_list`; none at all for an empty
+list), the urgent jobs once more after them. The poller
 returns what the poll read (:class:`Polled`, or :class:`PollFailed`) and
 :func:`app.link.sequence.poll` hands it on, in this order: one ``publish_polled`` of the pose /
 status / alarms (each only on change) and of the good poll, the restart canary (the supervisor),
@@ -31,8 +33,10 @@ from app.link.client import RobotClient
 from app.link.foreign import audit_sighting
 from app.link.host import PartLink
 from app.link.types import Operation
+from app.link.watch_list import WatchListReader
 from app.models import ControllerStatus, Pose
 from app.safety.envelope import EnvelopeViolation
+from app.watchlist.plan import WatchReadings
 
 __all__ = ["JOG_POLL_HZ_MIN", "PollFailed", "Polled", "Poller", "PoseWatch"]
 
@@ -71,6 +75,7 @@ class _Reading:
     guard_stop: EnvelopeViolation | None  # the jog guard's stop (ratio 0 before a boundary)
     canary: float | None  # the restart canary, read on the slow clock
     read_time: float  # s: the two reads' time on the wire, for the RTT
+    watched: WatchReadings | None = None  # the watch list's reads after the pose (None: none)
 
 
 @dataclasses.dataclass(frozen=True, slots=True)
@@ -116,6 +121,8 @@ class Poller:
         self.last_poll = 0.0  # monotonic time of the last poll attempt
         self.rtt = RttMeter(timing.RTT_REPORT_PERIOD)
         self.stats = LinkStatsReporter(timing.RTT_REPORT_PERIOD)
+        #: the watch list's reads after the pose (app/link/watch_list.py; None: no watch list)
+        self.watch_list: WatchListReader | None = None
 
     @staticmethod
     def rate(setting_hz: float, *, jogging: bool) -> float:
@@ -206,11 +213,25 @@ class Poller:
         host.run_urgent()  # and before this poll's publishing: a stop waits one read at most
         if not host.link_up:
             return None
+        watched = self._read_watch_list(client, timeout)  # then the urgent jobs again
+        if not host.link_up:
+            return None
         canary: float | None = None
         gv = canary_gv() if with_clock else None
         if gv is not None:
             canary = client.read_gv(gv)[0]  # the restart canary, on the slow clock
-        return _Reading(status, pose, guard_stop, canary, (t1 - t0) + (t3 - t2))
+        return _Reading(status, pose, guard_stop, canary, (t1 - t0) + (t3 - t2), watched)
+
+    def _read_watch_list(self, client: RobotClient, timeout: float) -> WatchReadings | None:
+        """The watch list's reads due in this poll, after the pose, then the urgent jobs (a stop
+        waits one read at most); nothing at all for an empty list."""
+        watch = self.watch_list
+        if watch is None or not watch.active:
+            return None
+        watched = watch.read(client, timeout)
+        if watched is not None:
+            self._host.run_urgent()
+        return watched
 
     def failed(self, exc: TeachPadError) -> None:
         """A failed poll: reported once per distinct error, the command in flight told."""
@@ -230,6 +251,8 @@ class Poller:
             self._host.publish_guard_stop(reading.guard_stop)
         status = self._clocked(polled.client, reading.status, polled.started, polled.with_clock)
         self.publish(reading.pose, status, good_at=polled.answered)
+        if reading.watched is not None and self.watch_list is not None:
+            self.watch_list.publish(reading.watched)
         return status, reading.pose
 
     def report_rtt(self, polled: Polled) -> None:

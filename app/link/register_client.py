@@ -91,6 +91,10 @@ class RegisterClient:
         self.watch_shared_every: float | None = None
         self._shared_read_at = -1e9
         self._noisy_line = on_noisy_line(settings)  # damaged frames are sent again (line_retry.py)
+        # the registers of the last pose and status reads, as answered (the watch list decodes the
+        # values it watches inside them from these: app/link/watch_list.py)
+        self.pose_registers: list[int] | None = None
+        self.status_registers: list[int] | None = None
 
     # -- connection ----------------------------------------------------------------------
     def connect(self) -> None:
@@ -348,11 +352,13 @@ class RegisterClient:
         ``timeout`` overrides the request timeout (the poller passes the poll timeout).
         """
         regs = self._read(registers.POSE_BLOCK_START, registers.POSE_BLOCK_COUNT, timeout)
+        self.pose_registers = regs
         return decode_pose(regs, self.settings.word_order)
 
     def read_status(self, with_clock: bool = False, *, timeout: float | None = None) -> ControllerStatus:
         """Table 2 (560..583) in one FC03; the clock (576..579) comes from the same block."""
         regs = self._read(registers.STATUS_BLOCK_START, registers.STATUS_BLOCK_COUNT, timeout)
+        self.status_registers = regs
         status = decode_status(
             regs, self.settings.word_order, self.settings.datetime_layout if with_clock else None
         )

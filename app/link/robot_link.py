@@ -71,6 +71,7 @@ class RobotLink(QObject):
     progressed = Signal(int, object)  # ticket, Progress (app/link/progress.py): a request's progress
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard stopped a jog
     registersRead = Signal(object)  # noqa: N815 - RegisterBlocks of a ReadRegisters op (its request_id)
+    watchRead = Signal(object)  # noqa: N815 - WatchReadings: the watch list's values (app/link/watch_list.py)
 
     _connectRequested = Signal(object)  # noqa: N815
     _disconnectRequested = Signal()  # noqa: N815
@@ -159,6 +160,7 @@ class RobotLink(QObject):
             (w.progressed, self._on_progress),
             (w.jogGuardStopped, self.jogGuardStopped),
             (w.registersRead, self.registersRead),
+            (w.watchRead, self.watchRead),
             (w.haltChanged, state.set_halt),
             (self._connectRequested, w.connect_to),
             (self._disconnectRequested, w.disconnect_link),

@@ -91,6 +91,7 @@ from app.link.supervisor import LinkSupervisor
 from app.link.transport import TrafficRecord
 from app.link.types import ConnectionState, LinkState, Operation, UnconfirmedHalt, WorkerError
 from app.link.upload import Uploader
+from app.link.watch_list import WatchListReader
 from app.models import CommandResult, ControllerStatus, Pose
 from app.protocol.registers import CANARY_GV
 from app.safety.audit import AuditLog
@@ -131,6 +132,7 @@ class RobotWorker(QObject):
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard wrote ratio 0
     haltChanged = Signal(object)  # noqa: N815 - UnconfirmedHalt | None: a stop the controller has not confirmed
     registersRead = Signal(object)  # noqa: N815 - RegisterBlocks: what a ReadRegisters op read
+    watchRead = Signal(object)  # noqa: N815 - WatchReadings: the watch list's reads of a poll (none: no list)
     stopped = Signal()  # the worker has closed the link and is quitting its thread (shutdown)
 
     # Wakes the worker from any thread (a queued call, since the worker lives in its thread).
@@ -179,6 +181,8 @@ class RobotWorker(QObject):
         self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
         self.commands = WorkerCommands(self)  # the short commands' handlers
         self.register_reads = RegisterReads(self)  # write-free block reads (the register-map self-test)
+        self.watch_list = WatchListReader(self, self.watchRead.emit)  # read after the pose (poller.py)
+        self.poller.watch_list = self.watch_list
         self.handlers = self._make_handlers()
 
     def _make_handlers(self) -> Handlers:
@@ -188,6 +192,7 @@ class RobotWorker(QObject):
         self.commands.register(handlers)  # the short ones (stop, pause, the jog ...)
         self.motions.register(handlers)  # the long ones (step, move to point ...)
         self.register_reads.register(handlers)  # block reads
+        self.watch_list.register(handlers)  # the watch list and an engineer's write of a value
         return handlers
 
     # --- requests (any thread) ----------------------------------------------------------

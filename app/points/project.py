@@ -71,6 +71,8 @@ from app.points.project_write import (
     FORMAT_VERSION,
     project_bytes,
 )
+from app.watchlist.project_io import KEY as WATCH_LIST_KEY
+from app.watchlist.project_io import watch_list_from
 
 PROJECT_SUFFIX = ".teachpad.json"
 
@@ -185,6 +187,7 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
     modified = _text_field(doc, "modified", top)
     points, history = _points_from(_expect(doc.get("points", []), list, top, "points", "points"), limits)
     plans = _plans_from(_expect(doc.get("plans", []), list, top, "plans", "plans"))
+    watch_list = watch_list_from(doc.get(WATCH_LIST_KEY))  # optional (docs/PROJECT_FORMAT.md)
     return Project(
         name=name,
         ledger=PointLedger.from_checked(points, limits),
@@ -193,6 +196,7 @@ def _project_from_dict(data: object, limits: PointLimits, *, scan_text: bool = T
         created=created,
         modified=modified,
         upload_history=history,
+        watch_list=tuple(watch_list),
     )
 
 

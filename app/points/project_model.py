@@ -11,6 +11,7 @@ from dataclasses import dataclass, field
 from app.errors import InvalidInput
 from app.plan.segments import Plan, validate_plan_name
 from app.points.ledger import PointLedger
+from app.watchlist.entry import WatchEntry
 
 HISTORY_TEXT_MAX = 200  # longest upload time / endpoint text kept as history
 
@@ -40,6 +41,8 @@ class Project:
     modified: str = ""
     #: point id -> the last upload of that point (history only; see :class:`LastUpload`)
     upload_history: dict[int, LastUpload] = field(default_factory=dict)
+    #: the GVs and registers watched (View -> Watch list), saved with the project
+    watch_list: tuple[WatchEntry, ...] = ()
     _revision: int = field(default=0, init=False, repr=False)
 
     def __post_init__(self) -> None:
@@ -65,6 +68,13 @@ class Project:
         for point_id in ids:
             self.upload_history[point_id] = LastUpload(stamp, endpoint[:HISTORY_TEXT_MAX])
         if ids:
+            self._revision += 1
+
+    def set_watch_list(self, entries: Iterable[WatchEntry]) -> None:
+        """Replace the watch list (a change of the project when it differs)."""
+        new = tuple(entries)
+        if new != self.watch_list:
+            self.watch_list = new
             self._revision += 1
 
     # --- plans

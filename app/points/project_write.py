@@ -22,6 +22,9 @@ from app.plan.segments import Segment
 from app.points import atomic
 from app.points.point import EXT_FIELDS, POSE_FIELDS, TempPoint
 from app.points.project_model import LastUpload, Project
+from app.watchlist.entry import WatchEntry
+from app.watchlist.project_io import KEY as WATCH_LIST_KEY
+from app.watchlist.project_io import watch_list_to_json
 
 FORMAT_NAME = "teachpad-project"
 FORMAT_VERSION = 1
@@ -72,6 +75,7 @@ class ProjectSnapshot:
     upload_history: Mapping[int, LastUpload]  # a read-only copy
     plans: tuple[PlanSnapshot, ...]
     revision: int
+    watch_list: tuple[WatchEntry, ...] = ()
 
 
 def take_snapshot(project: Project) -> ProjectSnapshot:
@@ -85,6 +89,7 @@ def take_snapshot(project: Project) -> ProjectSnapshot:
         upload_history=types.MappingProxyType(dict(project.upload_history)),
         plans=tuple(PlanSnapshot(p.name, p.loops, tuple(p.segments)) for p in project.plans),
         revision=project.revision,
+        watch_list=project.watch_list,
     )
 
 
@@ -106,6 +111,7 @@ def project_to_dict(project: Project | ProjectSnapshot) -> dict[str, Any]:
             {"name": p.name, "loops": p.loops, "segments": [_segment_to_dict(s) for s in p.segments]}
             for p in snap.plans
         ],
+        **({WATCH_LIST_KEY: watch_list_to_json(snap.watch_list)} if snap.watch_list else {}),
     }
 
 
@@ -146,6 +152,9 @@ def _project_pieces(snap: ProjectSnapshot) -> Iterator[str]:
         yield "}"
         first = False
     yield "[]" if first else "\n  ]"
+    if snap.watch_list:  # optional: a project without a watch list is written as before
+        yield f",\n  {_dumps(WATCH_LIST_KEY)}: "
+        yield from _json_list((_dumps(e) for e in watch_list_to_json(snap.watch_list)), "  ")
     yield "\n}\n"
 
 

@@ -81,6 +81,7 @@ class Action(enum.Enum):
     MANAGE_ROLES = "manage roles and passwords"
     SUPPORT_BUNDLE = "write a support bundle"
     WRITE_REGISTERS = "write controller registers directly"  # teachpad-cli write: any GV, unchecked
+    WRITE_WATCHED = "write a watched value"  # View -> Watch list: one GV / register, confirmed, audited
 
 
 #: The least role that may do each action.
@@ -99,6 +100,7 @@ REQUIRED_ROLE: dict[Action, Role] = {
     Action.EDIT_ENVELOPE: Role.ENGINEER,
     Action.ROBOT_MODEL: Role.ENGINEER,
     Action.LEAVE_REDUCED_SPEED: Role.ENGINEER,
+    Action.WRITE_WATCHED: Role.ENGINEER,
     Action.CONNECTION: Role.ADMINISTRATOR,
     Action.REGISTER_PROFILE: Role.ADMINISTRATOR,
     Action.MANAGE_ROLES: Role.ADMINISTRATOR,

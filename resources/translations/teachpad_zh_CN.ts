@@ -1765,7 +1765,7 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="356" />
+            <location filename="../../ui/main_window.py" line="358" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
@@ -1796,7 +1796,7 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>往返 —</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="402" />
+            <location filename="../../ui/main_window.py" line="404" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
@@ -1821,30 +1821,30 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>此控制器上还有另一个 Modbus 主站：{sign}。它与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。请检查还有谁连接着控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="425" />
+            <location filename="../../ui/main_window.py" line="427" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="380" />
-            <location filename="../../ui/main_window.py" line="404" />
-            <location filename="../../ui/main_window.py" line="413" />
-            <location filename="../../ui/main_window.py" line="426" />
+            <location filename="../../ui/main_window.py" line="382" />
+            <location filename="../../ui/main_window.py" line="406" />
+            <location filename="../../ui/main_window.py" line="415" />
+            <location filename="../../ui/main_window.py" line="428" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="333" />
+            <location filename="../../ui/main_window.py" line="335" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="334" />
+            <location filename="../../ui/main_window.py" line="336" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="335" />
+            <location filename="../../ui/main_window.py" line="337" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1854,37 +1854,37 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="420" />
+            <location filename="../../ui/main_window.py" line="422" />
             <source>plan run</source>
             <translation>计划运行</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="500" />
+            <location filename="../../ui/main_window.py" line="502" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="502" />
+            <location filename="../../ui/main_window.py" line="504" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="515" />
+            <location filename="../../ui/main_window.py" line="517" />
             <source>Safety state (roles, envelope, audit trail), machine-wide: {folder}</source>
             <translation>安全状态（角色、安全范围、审计记录），本机共用：{folder}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="517" />
+            <location filename="../../ui/main_window.py" line="519" />
             <source>Safety state (roles, envelope), this user's: {folder}&lt;br&gt;Audit trail: {audit}</source>
             <translation>安全状态（角色、安全范围），当前用户：{folder}&lt;br&gt;审计记录：{audit}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="536" />
+            <location filename="../../ui/main_window.py" line="538" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="536" />
+            <location filename="../../ui/main_window.py" line="538" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -1892,368 +1892,368 @@ The pendant connects to it and commands it; every other robot of the cell stays 
     <context>
         <name>Messages</name>
         <message>
-            <location filename="../../ui/messages.py" line="67" />
+            <location filename="../../ui/messages.py" line="68" />
             <source>{command}: {status}.</source>
             <translation>{command}：{status}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="68" />
+            <location filename="../../ui/messages.py" line="69" />
             <source>{command}: done, not confirmed by the controller.</source>
             <translation>{command}：已完成，控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="69" />
+            <location filename="../../ui/messages.py" line="70" />
             <source>{command}: done (the controller is now in {mode} mode).</source>
             <translation>{command}：已完成（控制器现处于{mode}模式）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="70" />
+            <location filename="../../ui/messages.py" line="71" />
             <source>{command} refused by the controller: {status}.</source>
             <translation>控制器拒绝了{command}：{status}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="71" />
+            <location filename="../../ui/messages.py" line="72" />
             <source>{command} not taken: the controller still shows “{status}” from the previous command.</source>
             <translation>{command}未被执行：控制器仍显示上一条命令的“{status}”。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="75" />
+            <location filename="../../ui/messages.py" line="76" />
             <source>{command} ended by an alarm: {alarms}.</source>
             <translation>{command}因报警而中止：{alarms}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="76" />
+            <location filename="../../ui/messages.py" line="77" />
             <source>{command}: the controller did not acknowledge it within {seconds} s.</source>
             <translation>{command}：控制器在 {seconds} s 内未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="79" />
+            <location filename="../../ui/messages.py" line="80" />
             <source>{command} did not finish within {seconds} s (last status: {status}).</source>
             <translation>{command}未在 {seconds} s 内完成（最后状态：{status}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="82" />
+            <location filename="../../ui/messages.py" line="83" />
             <source>{command}: the arm moved and stopped, but the controller did not report the result.</source>
             <translation>{command}：机械臂已运动并停止，但控制器未报告结果。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="85" />
+            <location filename="../../ui/messages.py" line="86" />
             <source>{command}: stopped by the operator.</source>
             <translation>{command}：已由操作员停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="86" />
+            <location filename="../../ui/messages.py" line="87" />
             <source>{command}: stopped by the controller.</source>
             <translation>{command}：已被控制器停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="87" />
+            <location filename="../../ui/messages.py" line="88" />
             <source>{command}: sent (not waited for).</source>
             <translation>{command}：已发送（未等待结果）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="88" />
+            <location filename="../../ui/messages.py" line="89" />
             <source>{command}: no motion within {seconds} s (refused by the controller, or already there).</source>
             <translation>{command}：{seconds} s 内没有运动（被控制器拒绝，或已在目标位置）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="92" />
+            <location filename="../../ui/messages.py" line="93" />
             <source>{command} refused by the controller: {alarms}.</source>
             <translation>{command}被控制器拒绝：{alarms}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="93" />
+            <location filename="../../ui/messages.py" line="94" />
             <source>{command}: sent; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{command}：已发送，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="96" />
+            <location filename="../../ui/messages.py" line="97" />
             <source>{command}: done (the axes were already at zero).</source>
             <translation>{command}：完成（各轴已在零位）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="97" />
+            <location filename="../../ui/messages.py" line="98" />
             <source>{command}: the arm stopped before zero ({axis} at {value}).</source>
             <translation>{command}：机械臂在到达零位前停止（{axis} 位于 {value}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="100" />
+            <location filename="../../ui/messages.py" line="101" />
             <source>{command} not sent: another Modbus master wrote to the controller less than {seconds} s ago and its writes could change this move. Make sure no other master is commanding the robot, then send it again.</source>
             <translation>{command}未发送：另一个 Modbus 主站在不到 {seconds} 秒前写入了控制器，它的写入可能改变这次运动。请确认没有其他主站在指挥机器人，然后再发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="105" />
+            <location filename="../../ui/messages.py" line="106" />
             <source>{command} not sent: a program or motion is under way on the controller; wait for it to end, or press Stop.</source>
             <translation>{command}未发送：控制器上有程序或运动正在进行；请等待其结束，或按停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="109" />
+            <location filename="../../ui/messages.py" line="110" />
             <source>{command}: the controller did not show it within {seconds} s.</source>
             <translation>{command}：控制器在 {seconds} s 内未显示该状态。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="112" />
+            <location filename="../../ui/messages.py" line="113" />
             <source>Program {program} did not start: no such program, or the controller refused it.</source>
             <translation>程序 {program} 未启动：没有该程序，或控制器拒绝执行。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="115" />
+            <location filename="../../ui/messages.py" line="116" />
             <source>Uploaded {uploaded} of {total} points.</source>
             <translation>已上传 {uploaded}/{total} 个点。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="117" />
+            <location filename="../../ui/messages.py" line="118" />
             <source>{operation}: sent.</source>
             <translation>{operation}：已发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="118" />
+            <location filename="../../ui/messages.py" line="119" />
             <source>{operation}: failed.</source>
             <translation>{operation}：失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="119" />
+            <location filename="../../ui/messages.py" line="120" />
             <source>{operation} is still under way: wait for it or press Stop.</source>
             <translation>{operation}仍在进行：请等待其结束或按停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="120" />
+            <location filename="../../ui/messages.py" line="121" />
             <source>{operation} is still under way: wait for it, cancel it or press Stop.</source>
             <translation>{operation}仍在进行：请等待其结束、取消它或按停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="123" />
+            <location filename="../../ui/messages.py" line="124" />
             <source>The link is shut down: nothing was sent.</source>
             <translation>通信链路已关闭：未发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="124" />
+            <location filename="../../ui/messages.py" line="125" />
             <source>Not connected to a controller: nothing was sent.</source>
             <translation>未连接控制器：未发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="126" />
+            <location filename="../../ui/messages.py" line="127" />
             <source>Jog stopped: the controller is not answering (speed 0 is sent as soon as it answers).</source>
             <translation>点动已停止：控制器无应答（一旦应答即发送速度 0）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="129" />
+            <location filename="../../ui/messages.py" line="130" />
             <source>Jog stopped: the controller left teach mode (now in {mode} mode).</source>
             <translation>点动已停止：控制器已退出示教模式（当前为{mode}模式）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="132" />
+            <location filename="../../ui/messages.py" line="133" />
             <source>The controller is not answering: the jog was not started.</source>
             <translation>控制器无应答：点动未启动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="136" />
+            <location filename="../../ui/messages.py" line="137" />
             <source>Releasing — the controller has not confirmed: it refused or did not answer speed 0. Speed 0 is sent again at every poll until the controller answers and the arm stands still.</source>
             <translation>正在松开 — 控制器尚未确认：它拒绝或未应答速度 0。每次轮询都会重新发送速度 0，直到控制器应答且机械臂静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="141" />
+            <location filename="../../ui/messages.py" line="142" />
             <source>Releasing — the controller has not confirmed speed 0 after {seconds} s: Stop is sent as well, at every poll, until the controller takes it.</source>
             <translation>正在松开 — {seconds} 秒后控制器仍未确认速度 0：每次轮询同时发送停止命令，直到控制器接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="146" />
+            <location filename="../../ui/messages.py" line="147" />
             <source>Jog stopped: the controller confirmed after {seconds} s and the arm stands still.</source>
             <translation>点动已停止：控制器在 {seconds} 秒后确认，机械臂已静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="149" />
+            <location filename="../../ui/messages.py" line="150" />
             <source>Stopping — the controller has not confirmed: it refused or did not answer the Stop. Stop is sent again at every poll until the controller takes it and the arm stands still.</source>
             <translation>正在停止 — 控制器尚未确认：它拒绝或未应答停止命令。每次轮询都会重新发送停止命令，直到控制器接受且机械臂静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="154" />
+            <location filename="../../ui/messages.py" line="155" />
             <source>Stop confirmed by the controller after {seconds} s; the arm stands still.</source>
             <translation>控制器在 {seconds} 秒后确认停止；机械臂已静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="157" />
+            <location filename="../../ui/messages.py" line="158" />
             <source>{operation} refused: the controller has not confirmed that the arm stopped (the stop is sent again at every poll). Press Stop, or wait until the arm stands still.</source>
             <translation>{operation}被拒绝：控制器尚未确认机械臂已停止（每次轮询都会重新发送停止）。请按停止，或等待机械臂静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="162" />
+            <location filename="../../ui/messages.py" line="163" />
             <source>The controller is not answering: the plan was not started. Try again when it answers.</source>
             <translation>控制器无应答：计划未启动。待其恢复应答后再试。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="165" />
+            <location filename="../../ui/messages.py" line="166" />
             <source>Jog speed {value}% is not within 1..100%.</source>
             <translation>点动速度 {value}% 不在 1..100% 范围内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="167" />
+            <location filename="../../ui/messages.py" line="168" />
             <source>Lost the connection to the controller at {endpoint}.</source>
             <translation>与控制器 {endpoint} 的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="168" />
+            <location filename="../../ui/messages.py" line="169" />
             <source>The controller at {endpoint} closed the connection.</source>
             <translation>控制器 {endpoint} 关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="169" />
+            <location filename="../../ui/messages.py" line="170" />
             <source>The host name {host} cannot be resolved.</source>
             <translation>无法解析主机名 {host}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="170" />
+            <location filename="../../ui/messages.py" line="171" />
             <source>The host name {host} is not valid: check it in Connect…</source>
             <translation>主机名 {host} 无效：请在“连接…”中检查。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="171" />
+            <location filename="../../ui/messages.py" line="172" />
             <source>Connection refused: nothing listens on port {port}.</source>
             <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="174" />
+            <location filename="../../ui/messages.py" line="175" />
             <source>No answer to the connection request within {seconds} s.</source>
             <translation>连接请求在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="177" />
+            <location filename="../../ui/messages.py" line="178" />
             <source>The connection could not be opened.</source>
             <translation>无法建立连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="178" />
+            <location filename="../../ui/messages.py" line="179" />
             <source>Cannot open the serial port {port}.</source>
             <translation>无法打开串口 {port}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="179" />
+            <location filename="../../ui/messages.py" line="180" />
             <source>The controller at {endpoint} did not answer within {seconds} s.</source>
             <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="182" />
+            <location filename="../../ui/messages.py" line="183" />
             <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
             <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="186" />
+            <location filename="../../ui/messages.py" line="187" />
             <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
             <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="190" />
+            <location filename="../../ui/messages.py" line="191" />
             <source>No device answered at unit id {unit} (Modbus exception {exception}, {name}): check the unit id in Connect…</source>
             <translation>从站地址 {unit} 上没有设备应答（Modbus 异常 {exception}，{name}）：请在“连接…”中检查从站地址。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="194" />
+            <location filename="../../ui/messages.py" line="195" />
             <source>Monitor-only mode: nothing was sent to the controller.</source>
             <translation>仅监视模式：未向控制器发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="195" />
+            <location filename="../../ui/messages.py" line="196" />
             <source>Not sent: the audit trail in {folder} cannot be written ({cause}). No write goes out without its record (Stop still does): free disk space or fix the audit folder.</source>
             <translation>未发送：审计记录目录 {folder} 无法写入（{cause}）。没有审计记录的写入一律不发送（停止除外）：请释放磁盘空间或修复审计目录。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="200" />
+            <location filename="../../ui/messages.py" line="201" />
             <source>{operation}: not sent, the controller is in {mode} mode. Switching it to auto is the operator's decision: say yes when the confirmation asks, or switch it to auto first.</source>
             <translation>{operation}：未发送，控制器处于{mode}模式。切换到自动模式须由操作员决定：在确认框询问时选择“是”，或先将其切换到自动模式。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="205" />
+            <location filename="../../ui/messages.py" line="206" />
             <source>{operation}: not sent in reduced-speed mode: it runs at the controller's own speed, which TeachPad cannot cap.</source>
             <translation>{operation}：降速模式下未发送：它以控制器自身的速度运行，TeachPad 无法限制该速度。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="210" />
+            <location filename="../../ui/messages.py" line="211" />
             <location filename="../../ui/messages_plan.py" line="29" />
             <source>Invalid value: nothing was sent.</source>
             <translation>数值无效：未发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="211" />
+            <location filename="../../ui/messages.py" line="212" />
             <source>Unexpected internal error; the log has the details.</source>
             <translation>意外的内部错误；详情见日志。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="213" />
+            <location filename="../../ui/messages.py" line="214" />
             <source>The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming.</source>
             <translation>机械臂停在 ({got})，距 {point} ({want}) {distance} mm：控制器中的该点与本项目不一致（被其他工具改写？）。恢复运行前请检查该点和机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="217" />
+            <location filename="../../ui/messages.py" line="218" />
             <source>The controller did not create {point} again before the move: the arm was not moved.</source>
             <translation>运动前控制器未能重新创建 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="220" />
+            <location filename="../../ui/messages.py" line="221" />
             <source>The project has no point {point}: the arm was not moved.</source>
             <translation>项目中没有点 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="223" />
+            <location filename="../../ui/messages.py" line="224" />
             <source>The arm's position after the move to {point} is not known: the run is stopped.</source>
             <translation>移动到 {point} 后机械臂的位置未知：运行已停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="227" />
+            <location filename="../../ui/messages.py" line="228" />
             <source>The link was shut down.</source>
             <translation>通信链路已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="237" />
+            <location filename="../../ui/messages.py" line="238" />
             <source>{operation}: not sent, the connection to the controller is down.</source>
             <translation>{operation}：未发送，与控制器的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="240" />
+            <location filename="../../ui/messages.py" line="241" />
             <source>{operation}: not sent, the connection was closed.</source>
             <translation>{operation}：未发送，连接已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="242" />
+            <location filename="../../ui/messages.py" line="243" />
             <source>points outside {id_min}..{id_max}: {ids}</source>
             <translation>超出 {id_min}..{id_max} 范围的点：{ids}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="243" />
+            <location filename="../../ui/messages.py" line="244" />
             <source>there is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="244" />
+            <location filename="../../ui/messages.py" line="245" />
             <source>no free point id left in {start}..{id_max}</source>
             <translation>{start}..{id_max} 范围内已没有空闲的点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="245" />
+            <location filename="../../ui/messages.py" line="246" />
             <source>there is no row {row}</source>
             <translation>不存在第 {row} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="246" />
+            <location filename="../../ui/messages.py" line="247" />
             <source>cannot move row {src} to {dst} in {rows} rows</source>
             <translation>无法在 {rows} 行中将第 {src} 行移到第 {dst} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="247" />
+            <location filename="../../ui/messages.py" line="248" />
             <source>row {row}: id {id} is already used on row {other}</source>
             <translation>第 {row} 行：编号 {id} 已被第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="248" />
+            <location filename="../../ui/messages.py" line="249" />
             <source>imported point {number}: id {id} appears twice</source>
             <translation>导入的第 {number} 个点：编号 {id} 出现了两次</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="249" />
+            <location filename="../../ui/messages.py" line="250" />
             <source>id {id} is already used by {point}</source>
             <translation>编号 {id} 已被 {point} 使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="250" />
+            <location filename="../../ui/messages.py" line="251" />
             <source>the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)</source>
             <translation>文件中没有点：用它替换将删除工程中全部 {existing} 个点（请改用合并，或明确要求空导入）</translation>
         </message>
@@ -2353,382 +2353,382 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>编号 {id} 已在第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="228" />
+            <location filename="../../ui/messages.py" line="229" />
             <source>{operation}: the connection was lost while it was under way; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{operation}：执行期间连接中断，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="232" />
+            <location filename="../../ui/messages.py" line="233" />
             <source>{operation}: the connection was closed while it was under way; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{operation}：执行期间连接被关闭，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="260" />
+            <location filename="../../ui/messages.py" line="262" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="261" />
+            <location filename="../../ui/messages.py" line="263" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="262" />
+            <location filename="../../ui/messages.py" line="264" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="263" />
+            <location filename="../../ui/messages.py" line="265" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="264" />
+            <location filename="../../ui/messages.py" line="266" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="265" />
+            <location filename="../../ui/messages.py" line="267" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="266" />
+            <location filename="../../ui/messages.py" line="268" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="267" />
+            <location filename="../../ui/messages.py" line="269" />
             <source>The host name is not valid.</source>
             <translation>主机名无效。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="268" />
+            <location filename="../../ui/messages.py" line="270" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="269" />
+            <location filename="../../ui/messages.py" line="271" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="270" />
+            <location filename="../../ui/messages.py" line="272" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="271" />
+            <location filename="../../ui/messages.py" line="273" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="272" />
+            <location filename="../../ui/messages.py" line="274" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="273" />
+            <location filename="../../ui/messages.py" line="275" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="274" />
+            <location filename="../../ui/messages.py" line="276" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="277" />
+            <location filename="../../ui/messages.py" line="279" />
             <source>{operation}: not sent, the controller is not in auto mode.</source>
             <translation>{operation}：未发送，控制器不处于自动模式。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="282" />
+            <location filename="../../ui/messages.py" line="284" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="283" />
+            <location filename="../../ui/messages.py" line="285" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="284" />
+            <location filename="../../ui/messages.py" line="286" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="285" />
+            <location filename="../../ui/messages.py" line="287" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="286" />
+            <location filename="../../ui/messages.py" line="288" />
             <source>Failed: {message}</source>
             <translation>失败：{message}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="289" />
+            <location filename="../../ui/messages.py" line="291" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="290" />
+            <location filename="../../ui/messages.py" line="292" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="291" />
+            <location filename="../../ui/messages.py" line="293" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="292" />
+            <location filename="../../ui/messages.py" line="294" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="293" />
+            <location filename="../../ui/messages.py" line="295" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="294" />
+            <location filename="../../ui/messages.py" line="296" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="295" />
+            <location filename="../../ui/messages.py" line="297" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="296" />
+            <location filename="../../ui/messages.py" line="298" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="297" />
+            <location filename="../../ui/messages.py" line="299" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="298" />
+            <location filename="../../ui/messages.py" line="300" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="299" />
+            <location filename="../../ui/messages.py" line="301" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="300" />
+            <location filename="../../ui/messages.py" line="302" />
             <source>move to temp point</source>
             <translation>运动至临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="301" />
+            <location filename="../../ui/messages.py" line="303" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="302" />
+            <location filename="../../ui/messages.py" line="304" />
             <source>cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="303" />
+            <location filename="../../ui/messages.py" line="305" />
             <source>teach disable</source>
             <translation>示教禁止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="304" />
+            <location filename="../../ui/messages.py" line="306" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="305" />
+            <location filename="../../ui/messages.py" line="307" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="306" />
+            <location filename="../../ui/messages.py" line="308" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="307" />
+            <location filename="../../ui/messages.py" line="309" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="308" />
+            <location filename="../../ui/messages.py" line="310" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="309" />
+            <location filename="../../ui/messages.py" line="311" />
             <source>read registers</source>
             <translation>读取寄存器</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="311" />
+            <location filename="../../ui/messages.py" line="313" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="314" />
+            <location filename="../../ui/messages.py" line="316" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="315" />
+            <location filename="../../ui/messages.py" line="317" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="316" />
+            <location filename="../../ui/messages.py" line="318" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="317" />
+            <location filename="../../ui/messages.py" line="319" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="318" />
+            <location filename="../../ui/messages.py" line="320" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="319" />
+            <location filename="../../ui/messages.py" line="321" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="320" />
+            <location filename="../../ui/messages.py" line="322" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="321" />
+            <location filename="../../ui/messages.py" line="323" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="322" />
+            <location filename="../../ui/messages.py" line="324" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="323" />
+            <location filename="../../ui/messages.py" line="325" />
             <source>unit id</source>
             <translation>从站地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="324" />
+            <location filename="../../ui/messages.py" line="326" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="328" />
+            <location filename="../../ui/messages.py" line="330" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="329" />
+            <location filename="../../ui/messages.py" line="331" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="330" />
+            <location filename="../../ui/messages.py" line="332" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="331" />
+            <location filename="../../ui/messages.py" line="333" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="332" />
+            <location filename="../../ui/messages.py" line="334" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="333" />
+            <location filename="../../ui/messages.py" line="335" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="334" />
+            <location filename="../../ui/messages.py" line="336" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="335" />
+            <location filename="../../ui/messages.py" line="337" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="336" />
+            <location filename="../../ui/messages.py" line="338" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="337" />
+            <location filename="../../ui/messages.py" line="339" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="339" />
+            <location filename="../../ui/messages.py" line="341" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="532" />
+            <location filename="../../ui/messages.py" line="534" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="535" />
+            <location filename="../../ui/messages.py" line="537" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="581" />
+            <location filename="../../ui/messages.py" line="583" />
             <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
             <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="584" />
+            <location filename="../../ui/messages.py" line="586" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="588" />
+            <location filename="../../ui/messages.py" line="590" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="591" />
+            <location filename="../../ui/messages.py" line="593" />
             <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="594" />
+            <location filename="../../ui/messages.py" line="596" />
             <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="624" />
+            <location filename="../../ui/messages.py" line="626" />
             <source>{operation}: not sent, cancelled by Stop.</source>
             <translation>{operation}：未发送，已被停止取消。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="625" />
+            <location filename="../../ui/messages.py" line="627" />
             <source>{operation}: not sent, the upload was cancelled.</source>
             <translation>{operation}：未发送，上传已取消。</translation>
         </message>
@@ -2778,12 +2778,12 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="541" />
+            <location filename="../../ui/messages.py" line="543" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="545" />
+            <location filename="../../ui/messages.py" line="547" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -3177,6 +3177,61 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <location filename="../../ui/messages_files.py" line="139" />
             <source>{file}: {text}</source>
             <translation>{file}：{text}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_watch.py" line="14" />
+            <source>Unknown type “{type}”: use float32, int16 or bits.</source>
+            <translation>未知类型“{type}”：可用的类型为 32 位浮点数、16 位整数或 16 位的位。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_watch.py" line="17" />
+            <source>Unknown source “{source}”: use gv or reg.</source>
+            <translation>未知来源“{source}”：可用 GV 或寄存器。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_watch.py" line="18" />
+            <source>“{text}” is not a GV or register number.</source>
+            <translation>“{text}”不是 GV 或寄存器编号。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_watch.py" line="19" />
+            <source>GV{value} is out of range (GV0..GV{max}).</source>
+            <translation>GV{value} 超出范围（GV0..GV{max}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_watch.py" line="20" />
+            <source>Register {value} is out of range (0..{max} for this type).</source>
+            <translation>寄存器 {value} 超出范围（此类型为 0..{max}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_watch.py" line="23" />
+            <source>A watched value's name is one line of at most {max} characters.</source>
+            <translation>监视值的名称只能是一行，最多 {max} 个字符。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_watch.py" line="26" />
+            <source>{name}: “{text}” is not a number.</source>
+            <translation>{name}：“{text}”不是数字。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_watch.py" line="27" />
+            <source>{name}: the value must be a finite number (not NaN).</source>
+            <translation>{name}：数值必须是有限数（不能是非数值）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_watch.py" line="28" />
+            <source>{name}: {value} is out of range ({min}..{max}).</source>
+            <translation>{name}：{value} 超出范围（{min}..{max}）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_watch.py" line="31" />
+            <source>{what}: registers 440..445 are the controller's commands; use the motion controls.</source>
+            <translation>{what}：寄存器 440..445 是控制器的命令寄存器；请使用运动控制按钮。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages_watch.py" line="34" />
+            <source>{what} = {value}: written.</source>
+            <translation>{what} = {value}：已写入。</translation>
         </message>
     </context>
     <context>
@@ -4121,104 +4176,104 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>控制器上没有该轨迹的点（控制器是否重启过？）：请点击“恢复全部”重新创建。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="328" />
+            <location filename="../../ui/controllers/point_sync.py" line="329" />
             <source>{what}: not connected to a controller</source>
             <translation>{what}：未连接控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="331" />
+            <location filename="../../ui/controllers/point_sync.py" line="332" />
             <source>{what}: wait until the current operation ends</source>
             <translation>{what}：请等待当前操作结束</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="362" />
+            <location filename="../../ui/controllers/point_sync.py" line="363" />
             <source>link lost</source>
             <translation>通信中断</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="383" />
+            <location filename="../../ui/controllers/point_sync.py" line="384" />
             <source>Connected to another controller ({endpoint}): {n} points are not known to be on it. Restore all to create them there.</source>
             <translation>已连接到另一台控制器（{endpoint}）：不知道它是否保存着这 {n} 个点。点击“恢复全部”在其上创建它们。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="388" />
+            <location filename="../../ui/controllers/point_sync.py" line="389" />
             <source>The controller restarted, or it is not the one the points were uploaded to: {n} points may be gone from it. Restore all to re-create them.</source>
             <translation>控制器已重启，或不是上传这些点的那台控制器：其上可能已没有这 {n} 个点。点击“恢复全部”重新创建它们。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="416" />
+            <location filename="../../ui/controllers/point_sync.py" line="417" />
             <source>Teach failed: {reason}</source>
             <translation>示教失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="425" />
+            <location filename="../../ui/controllers/point_sync.py" line="426" />
             <source>Move failed: {reason}</source>
             <translation>运动失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="436" />
+            <location filename="../../ui/controllers/point_sync.py" line="437" />
             <source>Teach P{id} failed: {reason}</source>
             <translation>示教 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="441" />
+            <location filename="../../ui/controllers/point_sync.py" line="442" />
             <source>P{id} was created on the controller, but its pose is not known yet</source>
             <translation>P{id} 已在控制器上创建，但其位姿尚未读取到</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="451" />
+            <location filename="../../ui/controllers/point_sync.py" line="452" />
             <source>P{id} was added on the host while teaching; the controller now holds the taught pose: upload it to keep the host's values</source>
             <translation>示教期间上位机已添加了 P{id}；控制器上现为示教位姿：如需保留上位机的数值请上传</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="460" />
+            <location filename="../../ui/controllers/point_sync.py" line="461" />
             <source>Teach P{id}: {reason}</source>
             <translation>示教 P{id}：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="465" />
+            <location filename="../../ui/controllers/point_sync.py" line="466" />
             <source>Taught P{id} at X {x:.3f}  Y {y:.3f}  Z {z:.3f}</source>
             <translation>已示教 P{id}：X {x:.3f}  Y {y:.3f}  Z {z:.3f}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="485" />
+            <location filename="../../ui/controllers/point_sync.py" line="486" />
             <source>Reached P{id}</source>
             <translation>已到达 P{id}</translation>
         </message>
         <message>
             <location filename="../../ui/controllers/point_sync.py" line="270" />
-            <location filename="../../ui/controllers/point_sync.py" line="489" />
+            <location filename="../../ui/controllers/point_sync.py" line="490" />
             <source>Move to P{id} stopped by the operator</source>
             <translation>运动到 P{id} 已由操作员停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="497" />
-            <location filename="../../ui/controllers/point_sync.py" line="506" />
+            <location filename="../../ui/controllers/point_sync.py" line="498" />
+            <location filename="../../ui/controllers/point_sync.py" line="507" />
             <source>Move to P{id} failed: {reason}</source>
             <translation>运动到 P{id} 失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="552" />
+            <location filename="../../ui/controllers/point_sync.py" line="560" />
             <source>cancelled</source>
             <translation>已取消</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="555" />
+            <location filename="../../ui/controllers/point_sync.py" line="563" />
             <source>stopped</source>
             <translation>已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="567" />
+            <location filename="../../ui/controllers/point_sync.py" line="575" />
             <source>Uploaded {n} points</source>
             <translation>已上传 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="572" />
+            <location filename="../../ui/controllers/point_sync.py" line="580" />
             <source>Upload stopped after {ok} of {total} points: {reason}</source>
             <translation>上传在 {ok}/{total} 个点后停止：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/point_sync.py" line="579" />
+            <location filename="../../ui/controllers/point_sync.py" line="587" />
             <source>Uploaded {ok} of {total} points; {failed} failed (P{id}: {reason})</source>
             <translation>已上传 {ok}/{total} 个点；{failed} 个失败（P{id}：{reason}）</translation>
         </message>
@@ -5141,12 +5196,12 @@ A {a:.3f}  B {b:.3f}  C {c:.3f}
             <translation>{path} 已在另一个 TeachPad 中打开（主机 {host} 上的进程 {pid}，自 {started} 起）。请先在那里关闭它；它的自动保存属于那个 TeachPad，此处不提供恢复。</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="535" />
+            <location filename="../../ui/controllers/project_controller.py" line="540" />
             <source>TeachPad projects (*.teachpad.json *.json);;All files (*)</source>
             <translation>TeachPad 工程 (*.teachpad.json *.json);;所有文件 (*)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/project_controller.py" line="538" />
+            <location filename="../../ui/controllers/project_controller.py" line="543" />
             <source>CSV files (*.csv);;All files (*)</source>
             <translation>CSV 文件 (*.csv);;所有文件 (*)</translation>
         </message>
@@ -7222,6 +7277,215 @@ Remove them all?</source>
             <translation>
                 <numerusform>轨迹在 %n 个段中超出可达范围（%1）</numerusform>
             </translation>
+        </message>
+    </context>
+    <context>
+        <name>WatchListHost</name>
+        <message>
+            <location filename="../../ui/window_watch_list.py" line="184" />
+            <source>Not connected, or monitor-only: nothing can be written</source>
+            <translation>未连接或处于仅监视模式：无法写入</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_watch_list.py" line="189" />
+            <location filename="../../ui/window_watch_list.py" line="212" />
+            <source>Write value</source>
+            <translation>写入数值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_watch_list.py" line="190" />
+            <source>New value of {what} ({type}):</source>
+            <translation>{what}（{type}）的新值：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_watch_list.py" line="204" />
+            <source>Write {value} to {what} ({where_reg}) on the controller at {endpoint}?
+
+It holds {old} now.</source>
+            <translation>将 {value} 写入控制器 {endpoint} 上的 {what}（{where_reg}）？
+
+当前值为 {old}。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_watch_list.py" line="210" />
+            <source>(not read)</source>
+            <translation>（未读取）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_watch_list.py" line="239" />
+            <source>The value was not written: {why}</source>
+            <translation>数值未写入：{why}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_watch_list.py" line="245" />
+            <source>Export the watch list</source>
+            <translation>导出监视列表</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_watch_list.py" line="247" />
+            <source>CSV files (*.csv)</source>
+            <translation>CSV 文件 (*.csv)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_watch_list.py" line="255" />
+            <source>Cannot write {path}: {error}</source>
+            <translation>无法写入 {path}：{error}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_watch_list.py" line="264" />
+            <source>Watch list</source>
+            <translation>监视列表</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_watch_list.py" line="265" />
+            <source>&amp;Watch list</source>
+            <translation>监视列表(&amp;W)</translation>
+        </message>
+    </context>
+    <context>
+        <name>WatchListModel</name>
+        <message>
+            <location filename="../../ui/models/watch_list_model.py" line="74" />
+            <source>Name</source>
+            <translation>名称</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/watch_list_model.py" line="74" />
+            <source>Where</source>
+            <translation>位置</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/watch_list_model.py" line="74" />
+            <source>Type</source>
+            <translation>类型</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/watch_list_model.py" line="74" />
+            <source>Value</source>
+            <translation>数值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/watch_list_model.py" line="74" />
+            <source>Age</source>
+            <translation>时效</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/watch_list_model.py" line="90" />
+            <source>Registers: {raw}</source>
+            <translation>寄存器：{raw}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/watch_list_model.py" line="102" />
+            <source>reg {n}</source>
+            <translation>寄存器 {n}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/watch_list_model.py" line="105" />
+            <source>bits</source>
+            <translation>位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/watch_list_model.py" line="110" />
+            <source>not read yet</source>
+            <translation>尚未读取</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/watch_list_model.py" line="112" />
+            <source>error</source>
+            <translation>错误</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/watch_list_model.py" line="115" />
+            <source>stale ({age:.1f} s)</source>
+            <translation>过时（{age:.1f} 秒）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/watch_list_model.py" line="116" />
+            <source>{age:.1f} s</source>
+            <translation>{age:.1f} 秒</translation>
+        </message>
+    </context>
+    <context>
+        <name>WatchListPanel</name>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="189" />
+            <source>{what} is in the list already</source>
+            <translation>{what} 已在列表中</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="192" />
+            <source>At most {n} values can be watched</source>
+            <translation>最多可监视 {n} 个数值</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="236" />
+            <source>Not connected, or monitor-only: nothing can be written</source>
+            <translation>未连接或处于仅监视模式：无法写入</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="239" />
+            <source>Write a value to the selected GV or register (confirmed, audited)</source>
+            <translation>向所选 GV 或寄存器写入数值（需确认，记入审计）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="323" />
+            <source>Register</source>
+            <translation>寄存器</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="324" />
+            <source>float32</source>
+            <translation>float32</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="324" />
+            <source>int16</source>
+            <translation>int16</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="324" />
+            <source>bits</source>
+            <translation>位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="327" />
+            <source>A GV (two registers, 2n and 2n+1) or a holding register by its address</source>
+            <translation>GV（两个寄存器 2n 和 2n+1）或按地址指定的保持寄存器</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="331" />
+            <source>float32: two registers in the register profile's word order; int16: one register, signed; bits: one register as 16 bits</source>
+            <translation>float32：两个寄存器，按寄存器配置的字序；int16：一个寄存器，有符号；bits：一个寄存器，显示 16 位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="335" />
+            <source>Name (optional)</source>
+            <translation>名称（可选）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="336" />
+            <source>Add</source>
+            <translation>添加</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="337" />
+            <source>Remove</source>
+            <translation>移除</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="338" />
+            <source>Write value…</source>
+            <translation>写入数值…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="339" />
+            <source>Export CSV…</source>
+            <translation>导出 CSV…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/watch_list_panel.py" line="346" />
+            <source>seconds ago</source>
+            <translation>秒前</translation>
         </message>
     </context>
     <context>

@@ -29,14 +29,17 @@ from app.link.ops import (
     RunProgram,
     SetJogRatio,
     SetMode,
+    SetWatchList,
     Step,
     Stop,
     UploadPoints,
+    WriteWatched,
 )
 from app.link.robot_link import RobotLink
 from app.link.types import JogRequest, StepFrame
 from app.models import CommandResult
 from app.protocol.enums import TeachFrame, WorkMode
+from app.watchlist.entry import Source, WatchEntry
 from tests.ui.fake_link import FakeLink
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     SIGNAL_TIMEOUT_MS,
@@ -65,6 +68,8 @@ EVERY_OP: tuple[LinkOp, ...] = (
     UploadPoints.of([(7, (400.0, 0.0, 300.0, 180.0, 0.0, 0.0))]),
     CancelUpload(),
     ReadRegisters(((412, 12), (560, 24))),
+    SetWatchList((WatchEntry.make(Source.GV, 10),), generation=1),
+    WriteWatched(WatchEntry.make(Source.GV, 10), 1.5),
 )
 
 
@@ -84,7 +89,8 @@ def test_each_operation_says_its_priority_class_and_coalescing() -> None:
     assert motion == {JogPress, SetJogRatio, Step, GoZero, RunProgram, MoveToPoint, UploadPoints}
     assert (JogPress.coalesce, SetJogRatio.coalesce) == (JOG_PRESS, JOG_RATIO)
     assert set(JogRelease.cancels) == {JOG_PRESS, JOG_RATIO}
-    assert {type(op) for op in EVERY_OP if not op.needs_link} == {Stop, JogRelease, CancelUpload}
+    no_link = {Stop, JogRelease, CancelUpload, SetWatchList}
+    assert {type(op) for op in EVERY_OP if not op.needs_link} == no_link
     assert {type(op) for op in EVERY_OP if op.tracks_motion} == {Step, GoZero, RunProgram, MoveToPoint}
 
 

@@ -522,6 +522,11 @@ class ProjectController(QObject):
             self.pathChanged.emit(str(path) if path else "")
         self._check_dirty(force=True)
 
+    def note_changed(self) -> None:
+        """The project changed outside the undo stack (its watch list): the title and the dirty
+        state follow."""
+        self._check_dirty()
+
     def _check_dirty(self, *_args: Any, force: bool = False) -> None:
         dirty = self.is_dirty
         if dirty != self._dirty or force:
