@@ -18,7 +18,7 @@ import pytest
 from pymodbus.constants import ExcCodes
 
 from app import errors
-from app.cli import controller, points, run_plan, support
+from app.cli import controller, points, run_plan, selftest, support
 from app.cli.exit_codes import EPILOG, LINK_ERRORS, ExitCode, exit_code_for
 from app.cli.help import walk
 from app.cli.main import REGISTRARS, build_parser, main
@@ -52,6 +52,7 @@ COMMANDS: list[tuple[Callable[[Any], None], set[str]]] = [
     ),
     (points.register, {"points"}),
     (run_plan.register, {"run"}),
+    (selftest.register, {"selftest"}),
     (support.register, {"support-bundle", "audit", "roles"}),
 ]
 
@@ -86,7 +87,9 @@ def test_every_leaf_command_has_a_handler() -> None:
         for path, sub in walk(build_parser())
         if path and not any(isinstance(a, argparse._SubParsersAction) for a in sub._actions)
     ]
-    assert len(leaves) == 24  # 14 controller (point create, program run) + 4 points + run + 5 offline
+    assert (
+        len(leaves) == 25
+    )  # 14 controller (point create, program run) + 4 points + run + selftest + 5 offline
     missing = [path for path, sub in leaves if not callable(sub.get_default("handler"))]
     assert missing == []
 
