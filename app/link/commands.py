@@ -78,6 +78,10 @@ class CommandsHost(Protocol):
         """The upload's next chunk, one event-loop turn later."""
         ...
 
+    def link_failed(self, cause: TeachPadError) -> None:
+        """A failed transaction, counted against the link (lost after too many in a row)."""
+        ...
+
 
 class WorkerCommands:
     """The short commands' handlers (see the module docstring); worker thread only."""
@@ -201,7 +205,7 @@ class WorkerCommands:
         _log.warning("%s (sent %.3f s ago)", text, now - sent)
         self._after_stop(now, text, Reason("stop_sent_fresh", args), main_link_failed=True)
         if main_failure is not None:  # it still counts against the main link
-            self._host.supervisor.transport_failed(main_failure)
+            self._host.link_failed(main_failure)
 
     def _report_stop_line(self, on_line: StopSent | None) -> bool:
         """The stop line's answer: checked, audited, shown in the traffic. True when the
@@ -227,7 +231,7 @@ class WorkerCommands:
             main_link_failed=True,
         )
         if isinstance(exc, LinkError | ResponseTimeout | MalformedResponse):
-            self._host.supervisor.transport_failed(exc)
+            self._host.link_failed(exc)
 
     def _after_stop(
         self, now: float, text: str, reason: Reason | None = None, *, main_link_failed: bool = False

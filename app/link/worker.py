@@ -4,7 +4,11 @@
 (created in the worker thread, like its timers). The GUI thread never waits for the network:
 requests go into a thread-safe :class:`~app.link.jobs.JobQueue` and results come back as signals.
 The worker only composes its parts, each a Qt-free class in its own module, all on the worker
-thread and calling back through :class:`~app.link.host.WorkerHost`:
+thread; each gets only what it uses (:mod:`app.link.host`: the client, ``run_urgent``, the
+emitters, a narrow view or callable of another part), none gets the worker with its siblings.
+The worker sequences them: a poll's outcome through :mod:`app.link.sequence`, the link's changes
+(connect, silence, failures, loss, close) through :mod:`app.link.lifecycle`, the supervisor
+deciding and the other parts told in turn:
 
 * :class:`~app.link.supervisor.LinkSupervisor` -- connect, backoff, link loss, *not answering*,
   the restart canary.
@@ -71,6 +75,7 @@ from app.errors import (
     TeachPadError,
     WriteBlocked,
 )
+from app.link import lifecycle
 from app.link.active import MotionTracker
 from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
@@ -84,7 +89,7 @@ from app.link.sequence import poll
 from app.link.state import PollUpdate
 from app.link.stats import LinkStats
 from app.link.stop_line import StopLine
-from app.link.supervisor import LinkSupervisor
+from app.link.supervisor import Cause, LinkSupervisor
 from app.link.transport import TrafficRecord
 from app.link.types import ConnectionState, LinkState, Operation, UnconfirmedHalt, WorkerError
 from app.link.upload import Uploader
@@ -158,9 +163,7 @@ class RobotWorker(QObject):
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
         self.poller = Poller(self, self.motion)
-        self.supervisor = LinkSupervisor(  # raises on a bad canary GV
-            self, canary_gv, tracker=self.motion, capture=self.capture
-        )
+        self.supervisor = LinkSupervisor(self, canary_gv, capture=self.capture)  # raises on a bad canary GV
         self.stop_line = StopLine()  # the stop's own connection; send_stop from any thread
         # a stop counts on the stop line before its 441 goes out, then (and a cancel) in the queue
         self.uploader = Uploader(self, lambda: self.stop_line.stops_requested + self._jobs.halts)
@@ -230,20 +233,20 @@ class RobotWorker(QObject):
         """(Re)connect with ``settings``; retries by itself until :meth:`disconnect_link`."""
         if not self.closed:
             self.stop_line.reset(settings if self.use_stop_line else None)
-            self.supervisor.connect_to(settings)
+            lifecycle.connect(self, settings)
 
     @Slot()
     def disconnect_link(self) -> None:
         """Stop jogging, switch teach off, close the link, stop retrying."""
         if not self.closed:
-            self.supervisor.close_link(Operation.DISCONNECT, LinkState.DISCONNECTED, "")
+            lifecycle.close_link(self, Operation.DISCONNECT, LinkState.DISCONNECTED, "")
 
     @Slot()
     def shutdown(self) -> None:
         """Queued from the GUI: stop motion, close, hand the object back, quit this thread."""
         if self.closed:
             return
-        self.supervisor.close_link(Operation.SHUTDOWN, LinkState.DISCONNECTED, "", short=True)
+        lifecycle.close_link(self, Operation.SHUTDOWN, LinkState.DISCONNECTED, "", short=True)
         self.flush_traffic()  # the close's own frames (teach off) before the thread ends
         self.closed = True
         self._worker_ident = None
@@ -350,6 +353,18 @@ class RobotWorker(QObject):
         if time.monotonic() - self.poller.last_poll >= 1.0 / self._poll_rate():
             self._poll()
 
+    def link_failed(self, cause: Cause) -> None:
+        """A failed transaction counted against the link (lost after too many in a row)."""
+        lifecycle.link_failed(self, cause)
+
+    def leave_teach(self) -> None:
+        """Teach mode off (the jog ended) before a command that moves the arm (an upload)."""
+        self.jog.leave_teach(self.poller.last_status)
+
+    @property
+    def canary_gv(self) -> int | None:
+        return self.supervisor.canary_gv
+
     def start_polling(self) -> None:
         if self._poll_timer is not None:
             self._poll_timer.start(self._poll_interval_ms())
@@ -450,7 +465,7 @@ class RobotWorker(QObject):
     # --- timers and queued calls (worker thread) ----------------------------------------
     @Slot()
     def _try_connect(self) -> None:
-        self.supervisor.try_connect()
+        lifecycle.try_connect(self)
 
     @Slot()
     def _on_tick(self) -> None:
@@ -560,4 +575,4 @@ class RobotWorker(QObject):
         if isinstance(exc, LinkError | ResponseTimeout | MalformedResponse) and not isinstance(
             exc, WriteBlocked
         ):
-            self.supervisor.transport_failed(exc)
+            self.link_failed(exc)

@@ -52,7 +52,8 @@ def test_a_malformed_answer_at_connect_is_a_link_failure(
     kinds = [s.state for s in states]
     down = kinds.index(LinkState.DOWN)  # a link failure: DOWN, retrying by itself ...
     assert kinds[:down] == [LinkState.CONNECTING]  # ... never CONNECTED on the malformed answer
-    assert states[down].reason is not None and states[down].reason.code == "malformed_answer"
+    reason = states[down].reason
+    assert reason is not None and reason.code == "malformed_answer"
     assert "malformed answer" in states[down].message
     assert kinds[-1] is LinkState.CONNECTED  # the worker lived on: a later attempt connected
     assert all(e.reason is not None for e in errors), errors  # no bare exception (a crash) reported
