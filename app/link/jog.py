@@ -31,7 +31,7 @@ from app.errors import (
     TeachPadError,
 )
 from app.link.active import MotionTracker
-from app.link.halt import HaltWatch, HaltWrite, halt_refusal
+from app.link.halt import HaltWatch, HaltWrite, follow_refused_stop, halt_refusal, settle
 from app.link.host import PartLink
 from app.link.outcome import UNKNOWN_ADVICE
 from app.link.tracker import CommandTracker
@@ -233,11 +233,7 @@ class JogMachine:
             if jog is not None or self.teach.moving:
                 self.teach_dirty = True  # the link failed: speed 0 and teach off on its return
             return
-        halt = self.halt
-        if halt is None or halt.kind is not HaltKind.STOP:
-            request = jog if jog is not None else (halt.request if halt is not None else None)
-            halt = self.halt = HaltWatch(HaltKind.STOP, request, time.monotonic())
-        halt.refused(HaltWrite.STOP, exc)
+        self.halt = follow_refused_stop(self.halt, jog, exc, time.monotonic())
         self._publish_halt()
 
     # --- jobs ----------------------------------------------------------------------------
@@ -424,18 +420,10 @@ class JogMachine:
         client = self._host.client
         if halt is None or client is None or client.settings.monitor_only:
             return
-        failure: TeachPadError | None = None
         # each write waits the poll timeout at most: a controller that does not answer it gets it
         # again at the next poll, it does not hold the worker for the request timeout
         with client.io_timeout(client.settings.effective_poll_timeout):
-            for write in halt.due(time.monotonic()):
-                try:
-                    self._send(write)
-                except TeachPadError as exc:
-                    halt.refused(write, exc)
-                    if not halt_refusal(exc):
-                        failure = exc
-                        break
+            failure = settle(self._send, halt, time.monotonic())
         self._publish_halt()
         if failure is not None:
             raise failure

@@ -80,6 +80,7 @@ from app.link.active import MotionTracker
 from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
 from app.link.commands import WorkerCommands
+from app.link.halt import StopJob, post_stop
 from app.link.jobs import Job, JobQueue
 from app.link.jog import JogMachine, PreemptedError
 from app.link.motion import MotionCommands
@@ -177,14 +178,24 @@ class RobotWorker(QObject):
             self, self.motion, self.jog, self.poller, uploading=lambda: self.uploader.run is not None
         )
         self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
-        self.commands = WorkerCommands(self)  # the short commands' handlers
+        self.stop_job = StopJob(  # everything a Stop does: app/link/halt.py
+            self,
+            line=self.stop_line,
+            capture=self.capture,
+            jog=self.jog,
+            tracker=self.motion,
+            end_upload=self.uploader.end,
+        )
+        # the short commands' handlers
+        self.commands = WorkerCommands(self, jog=self.jog, motions=self.motions, uploader=self.uploader)
         self.handlers = self._make_handlers()
 
     def _make_handlers(self) -> Handlers:
         """The one table: operation type -> what runs it (worker thread); each part registers
         the operations it runs."""
         handlers = Handlers()
-        self.commands.register(handlers)  # the short ones (stop, pause, the jog ...)
+        self.stop_job.register(handlers)  # the Stop
+        self.commands.register(handlers)  # the short ones (pause, the jog ...)
         self.motions.register(handlers)  # the long ones (step, move to point ...)
         return handlers
 
@@ -197,19 +208,19 @@ class RobotWorker(QObject):
         answer, the bookkeeping). Without a stop line, from another thread, this waits (GIL
         released) until the worker has written it, at most :data:`STOP_HANDOFF_WAIT`, so nothing
         of the caller's runs first. The stop runs whatever the link's state: without a link it
-        goes over a fresh connection to the last controller (``WorkerCommands.stop``)."""
+        goes over a fresh connection to the last controller (:class:`~app.link.halt.StopJob`)."""
         if not isinstance(op, Stop):
             request_id = self._jobs.put(Job(op))
             self._wake.emit()
             return request_id
-        on_line = self.stop_line.send_stop()
-        sent = threading.Event()
-        request_id = self._jobs.put(Job(op, sent=sent, on_line=on_line))
-        self._wake.emit()
-        worker = self._worker_ident
-        if on_line is None and worker is not None and worker != threading.get_ident():
-            sent.wait(STOP_HANDOFF_WAIT)
-        return request_id
+        return post_stop(
+            op,
+            self.stop_line,
+            self._jobs.put,
+            self._wake.emit,
+            worker_thread=self._worker_ident,
+            handoff_wait=STOP_HANDOFF_WAIT,
+        )
 
     # --- lifecycle (worker thread) ------------------------------------------------------
     @Slot()
@@ -342,6 +353,11 @@ class RobotWorker(QObject):
     @property
     def link_up(self) -> bool:
         return self.supervisor.link_up
+
+    @property
+    def last_settings(self) -> ConnectionSettings | None:
+        """The last controller's settings (None: none asked for yet)."""
+        return self.supervisor.settings
 
     def client_or_raise(self) -> RobotClient:
         client = self.supervisor.client
