@@ -89,6 +89,7 @@ __all__ = [
     "post_stop",
     "settle",
     "stop_on_a_fresh_connection",
+    "write_halt_stop",
 ]
 
 _log = logging.getLogger(__name__)
@@ -339,6 +340,30 @@ def settle(write: Callable[[HaltWrite], None], watch: HaltWatch, now: float) -> 
             if not halt_refusal(exc):
                 return exc
     return None
+
+
+def write_halt_stop(
+    client: RobotClient,
+    watch: HaltWatch | None,
+    tracker: MotionTracker,
+    emit_result: Callable[[CommandResult, int | None], None],
+) -> None:
+    """The Stop (441) a halt asks for (escalated, or a refused Stop sent again), on the main link;
+    answered: the watch counts it and the command in flight ends as stopped (as after the
+    operator's Stop)."""
+    client.stop()
+    if watch is not None:
+        watch.took(HaltWrite.STOP, time.monotonic())
+    _end_command_in_flight(tracker, emit_result, time.monotonic())
+
+
+def _end_command_in_flight(
+    tracker: MotionTracker, emit_result: Callable[[CommandResult, int | None], None], now: float
+) -> None:
+    """A Stop the controller took ends the command it was carrying out: stopped, with its request id."""
+    active = tracker.take()
+    if active is not None:
+        emit_result(active.completion.stopped(now), active.request_id)
 
 
 # --- the operator's Stop -------------------------------------------------------------------------
@@ -625,9 +650,7 @@ class StopJob:
             self._end_jog_after_a_failed_stop()
         else:
             self._jog.on_stop()  # speed 0; a failure here is the Stop's error, as before
-        active = self._tracker.take()
-        if active is not None:
-            host.emit_result(active.completion.stopped(now), active.request_id)
+        _end_command_in_flight(self._tracker, host.emit_result, now)
         host.emit_result(CommandResult(None, None, None, True, text, reason=reason))
 
     def _end_jog_after_a_failed_stop(self) -> None:

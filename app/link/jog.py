@@ -31,7 +31,7 @@ from app.errors import (
     TeachPadError,
 )
 from app.link.active import MotionTracker
-from app.link.halt import HaltWatch, HaltWrite, follow_refused_stop, halt_refusal, settle
+from app.link.halt import HaltWatch, HaltWrite, follow_refused_stop, halt_refusal, settle, write_halt_stop
 from app.link.host import PartLink
 from app.link.outcome import UNKNOWN_ADVICE
 from app.link.tracker import CommandTracker
@@ -491,17 +491,7 @@ class JogMachine:
         client = self._host.client
         if client is None:
             raise LinkError("not connected to a controller", code="not_connected")
-        client.stop()
-        self._stop_taken()
-
-    def _stop_taken(self) -> None:
-        """A Stop this machine sent was answered: the motion in flight ends as stopped."""
-        halt = self.halt
-        if halt is not None:
-            halt.took(HaltWrite.STOP, time.monotonic())
-        active = self._tracker.take()
-        if active is not None:
-            self._host.emit_result(active.completion.stopped(time.monotonic()), active.request_id)
+        write_halt_stop(client, self.halt, self._tracker, self._host.emit_result)
 
     def _publish_halt(self, *, quiet: bool = False) -> None:
         """Tell the GUI what changed (and, the first time it goes wrong, why, unless ``quiet``)."""
