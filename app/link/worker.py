@@ -33,12 +33,14 @@ deciding and the other parts told in turn:
 
 Requests are operations as data (:mod:`app.link.ops`): :meth:`RobotWorker.submit` queues one
 and returns its ticket (request id); the worker runs each through one table, operation type ->
-handler (``handlers``). The handlers of the short commands (``stop`` ...) are in
+handler (``handlers``). The handlers of the short commands (``pause`` ...) are in
 :class:`~app.link.commands.WorkerCommands`, those of the long ones in
-:class:`~app.link.motion.MotionCommands`: parts the worker composes, like the others.
+:class:`~app.link.motion.MotionCommands`, the Stop's in :class:`~app.link.halt.StopJob`: parts
+the worker composes, like the others.
 
-Stop latency: :meth:`RobotWorker.submit` of a :class:`~app.link.ops.Stop` writes the stop from
-the calling thread on the stop line (:mod:`app.link.stop_line`) when there is one; the stop job
+Stop latency (everything a Stop does: :mod:`app.link.halt`): :meth:`RobotWorker.submit` of a
+:class:`~app.link.ops.Stop` writes the stop from the calling thread on the stop line
+(:func:`~app.link.halt.post_stop`, :mod:`app.link.stop_line`) when there is one; the stop job
 then writes it on the main link too, after the transaction in flight (ordering), and reads the
 line's answer. Without a line the GUI thread waits (GIL released, at most
 :data:`STOP_HANDOFF_WAIT`) for the worker to write it.
