@@ -181,7 +181,7 @@ def test_a_stop_ends_the_point_in_flight_at_once_when_its_result_never_shows(
     sim = sim_factory(command_latency=60.0)
     host.connect(sim)
 
-    def stop() -> None:  # what the worker's stop job does first (app/link/commands.py)
+    def stop() -> None:  # what the worker's stop job does first (app/link/halt.py)
         host.client_or_raise().stop()
         host.uploader.end("stopped")
 
