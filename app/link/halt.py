@@ -35,7 +35,8 @@ answered") that lives here: **a jog is over only when the controller has answere
 * the operator is told: the jog panel says "releasing -- the controller has not confirmed".
 
 A Stop the controller refused is followed the same way (its own write, 441, from the start:
-:func:`follow_refused_stop`). teachpad-cli gives up after :data:`app.timing.HALT_CONFIRM_BUDGET`
+:func:`follow_refused_stop`); a halt's Stop, once answered, ends the command in flight as the
+operator's does (:func:`write_halt_stop`). teachpad-cli gives up after :data:`app.timing.HALT_CONFIRM_BUDGET`
 s and says so (exit 1).
 
 :class:`HaltWatch` is the policy alone: what to write now, what the answers and the poses mean.
@@ -52,7 +53,7 @@ import logging
 import threading
 import time
 from collections.abc import Callable
-from typing import Protocol
+from typing import TYPE_CHECKING, Protocol
 
 from app import timing
 from app.connection import ConnectionSettings
@@ -65,16 +66,18 @@ from app.errors import (
     TeachPadError,
     WriteBlocked,
 )
-from app.link.active import MotionTracker
 from app.link.arrival import pose_moved
-from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
 from app.link.jobs import Job
 from app.link.ops import Handlers, JobKind, Stop
-from app.link.stop_line import StopLine, StopSent
 from app.link.types import HaltKind, JogRequest, UnconfirmedHalt
 from app.models import CommandResult, Pose
 from app.safety.audit import AuditLog
+
+if TYPE_CHECKING:  # (the stop line's transport needs pymodbus: teachpad-cli loads it only to connect)
+    from app.link.active import MotionTracker
+    from app.link.capture import TrafficCapture
+    from app.link.stop_line import StopLine, StopSent
 
 __all__ = [
     "RETRY_EXCEPTIONS",
