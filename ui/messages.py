@@ -579,7 +579,7 @@ def os_error_text(path: object, exc: OSError) -> str:
 
 
 # A Stop the main link could not carry went over a fresh connection to the last controller
-# (app/link/commands.py: disconnected, lost, or its own stop failed), or could not reach it.
+# (app/link/halt.py: disconnected, lost, or its own stop failed), or could not reach it.
 _TEMPLATES["stop_sent_fresh"] = QT_TRANSLATE_NOOP(
     "Messages", "Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it)."
 )

@@ -22,17 +22,7 @@ if TYPE_CHECKING:
     from app.safety.caps import MotionCaps
     from app.safety.envelope import EnvelopeViolation
 
-__all__ = [
-    "JogView",
-    "PartLink",
-    "PollerView",
-    "Readings",
-    "SupervisorView",
-    "TeachGate",
-    "UploaderView",
-    "WorkerHost",
-    "WorkerOutputs",
-]
+__all__ = ["PartLink", "Readings", "TeachGate", "UploadLink", "WorkerOutputs"]
 
 
 class WorkerOutputs(Protocol):
@@ -60,23 +50,9 @@ class WorkerOutputs(Protocol):
         """A write that stops motion is not confirmed by the controller (None: nothing is)."""
 
 
-# What one part uses of another, and no more: each view lists exactly the members the other
-# parts reach (this module imports no part, so no part's module is in a circle with another).
-
-
-class SupervisorView(Protocol):
-    """The :class:`~app.link.supervisor.LinkSupervisor` as the poller, the jog and the upload see it."""
-
-    @property
-    def answering(self) -> bool: ...
-    @property
-    def canary_gv(self) -> int | None: ...
-    @property
-    def canary_token(self) -> float | None: ...
-    def canary_read(self, value: float) -> None: ...
-    def poll_answered(self) -> None: ...
-    def poll_silent(self, cause: TeachPadError | str, now: float) -> None: ...
-    def transport_failed(self, cause: TeachPadError | str) -> None: ...
+# What one part uses of another, and no more (this module imports no part, so no part's module
+# is in a circle with another). No part gets the worker with its siblings: the worker sequences
+# them (app/link/sequence.py, app/link/lifecycle.py).
 
 
 class Readings(Protocol):
@@ -86,14 +62,6 @@ class Readings(Protocol):
     def last_pose(self) -> Pose | None: ...
     @property
     def last_status(self) -> ControllerStatus | None: ...
-
-
-class PollerView(Readings, Protocol):
-    """The :class:`~app.link.poller.Poller` as the supervisor sees it."""
-
-    def reset(self, now: float) -> None: ...
-    def forget(self) -> None: ...
-    def publish(self, pose: Pose, status: ControllerStatus, good_at: float | None = None) -> None: ...
 
 
 class TeachGate(Protocol):
@@ -106,38 +74,6 @@ class TeachGate(Protocol):
     def leave_teach(self, last_status: ControllerStatus | None) -> None:
         """Teach mode off (the jog ended) before a command that moves the arm."""
         ...
-
-
-class JogView(TeachGate, Protocol):
-    """The :class:`~app.link.jog.JogMachine` as the supervisor and the upload see it."""
-
-    @property
-    def jogging(self) -> bool: ...
-    @property
-    def halting(self) -> bool: ...
-    def reset(self) -> None: ...
-    def link_lost(self) -> None: ...
-    def controller_silent(self) -> None: ...
-    def controller_answers(self) -> None: ...
-    def make_teach_safe(self, status: ControllerStatus, ever_connected: bool) -> None: ...
-    def stop_jog_and_teach(self) -> None: ...
-    def after_status(self, status: ControllerStatus, now: float, *, idle: bool) -> None: ...
-    def guard_pose(
-        self, pose: Pose, read_at: float | None = None, answered_at: float | None = None
-    ) -> EnvelopeViolation | None: ...
-    def halt_pose(self, pose: Pose) -> None: ...
-    def settle_halt(self) -> None: ...
-
-
-class UploaderView(Protocol):
-    """The :class:`~app.link.upload.Uploader` as the supervisor and the commands see it."""
-
-    @property
-    def run(self) -> object | None:
-        """The upload under way (None: none)."""
-        ...
-
-    def end(self, reason: str) -> None: ...
 
 
 class PartLink(WorkerOutputs, Protocol):
@@ -170,34 +106,23 @@ class PartLink(WorkerOutputs, Protocol):
     def emit_exception(self, operation: str, exc: BaseException, request_id: int | None = -1) -> None: ...
 
 
-class WorkerHost(PartLink, Protocol):
-    """The worker as the parts not yet narrowed use it: the siblings through their views."""
+class UploadLink(PartLink, Protocol):
+    """What the :class:`~app.link.upload.Uploader` uses of the worker besides :class:`PartLink`:
+    the callables the worker composes from the other parts, no part itself."""
 
     @property
-    def supervisor(self) -> SupervisorView: ...
-    @property
-    def poller(self) -> PollerView: ...
-    @property
-    def jog(self) -> JogView: ...
-    @property
-    def uploader(self) -> UploaderView: ...
+    def canary_gv(self) -> int | None:
+        """The restart canary's GV (the upload's second pose block moves past it; None: none)."""
+        ...
 
-    def run_jobs(self) -> None: ...
+    def leave_teach(self) -> None:
+        """Teach mode off (the jog ended) before the upload's commands."""
+        ...
 
     def poll_if_due(self) -> None:
         """A poll now if one is due (long jobs keep the monitor live)."""
         ...
 
-    def fail_queued(self, message: str, code: str | None = None) -> None: ...
-
-    def flush_traffic(self) -> None:
-        """Publish the frames captured so far now (the worker also does on its own period)."""
+    def link_failed(self, cause: TeachPadError | str) -> None:
+        """A failed transaction, counted against the link (lost after too many in a row)."""
         ...
-
-    def start_polling(self) -> None: ...
-
-    def stop_polling(self) -> None: ...
-
-    def start_reconnect(self, delay: float) -> None: ...
-
-    def stop_reconnect(self) -> None: ...

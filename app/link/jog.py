@@ -31,7 +31,7 @@ from app.errors import (
     TeachPadError,
 )
 from app.link.active import MotionTracker
-from app.link.halt import HaltWatch, HaltWrite, halt_refusal
+from app.link.halt import HaltWatch, HaltWrite, follow_refused_stop, halt_refusal, settle, write_halt_stop
 from app.link.host import PartLink
 from app.link.outcome import UNKNOWN_ADVICE
 from app.link.tracker import CommandTracker
@@ -233,11 +233,7 @@ class JogMachine:
             if jog is not None or self.teach.moving:
                 self.teach_dirty = True  # the link failed: speed 0 and teach off on its return
             return
-        halt = self.halt
-        if halt is None or halt.kind is not HaltKind.STOP:
-            request = jog if jog is not None else (halt.request if halt is not None else None)
-            halt = self.halt = HaltWatch(HaltKind.STOP, request, time.monotonic())
-        halt.refused(HaltWrite.STOP, exc)
+        self.halt = follow_refused_stop(self.halt, jog, exc, time.monotonic())
         self._publish_halt()
 
     # --- jobs ----------------------------------------------------------------------------
@@ -424,18 +420,10 @@ class JogMachine:
         client = self._host.client
         if halt is None or client is None or client.settings.monitor_only:
             return
-        failure: TeachPadError | None = None
         # each write waits the poll timeout at most: a controller that does not answer it gets it
         # again at the next poll, it does not hold the worker for the request timeout
         with client.io_timeout(client.settings.effective_poll_timeout):
-            for write in halt.due(time.monotonic()):
-                try:
-                    self._send(write)
-                except TeachPadError as exc:
-                    halt.refused(write, exc)
-                    if not halt_refusal(exc):
-                        failure = exc
-                        break
+            failure = settle(self._send, halt, time.monotonic())
         self._publish_halt()
         if failure is not None:
             raise failure
@@ -503,17 +491,7 @@ class JogMachine:
         client = self._host.client
         if client is None:
             raise LinkError("not connected to a controller", code="not_connected")
-        client.stop()
-        self._stop_taken()
-
-    def _stop_taken(self) -> None:
-        """A Stop this machine sent was answered: the motion in flight ends as stopped."""
-        halt = self.halt
-        if halt is not None:
-            halt.took(HaltWrite.STOP, time.monotonic())
-        active = self._tracker.take()
-        if active is not None:
-            self._host.emit_result(active.completion.stopped(time.monotonic()), active.request_id)
+        write_halt_stop(client, self.halt, self._tracker, self._host.emit_result)
 
     def _publish_halt(self, *, quiet: bool = False) -> None:
         """Tell the GUI what changed (and, the first time it goes wrong, why, unless ``quiet``)."""

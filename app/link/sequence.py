@@ -5,7 +5,8 @@ The poller reads and returns what it read; this hands it on, in the order docs/D
 describes ("The poller"): a failed poll to the supervisor (silence, a failed transaction); a good
 one to the supervisor (answering again), then published, the restart canary to the supervisor,
 another master's signs, the command it completed (the tracker), the jog's teach watch, the RTT
-and the link statistics. No part calls another for a poll.
+and the link statistics. What the supervisor decides on the way (the link lost, answering again)
+goes on to the other parts through :mod:`app.link.lifecycle`. No part calls another for a poll.
 """
 
 from __future__ import annotations
@@ -13,30 +14,19 @@ from __future__ import annotations
 import time
 from typing import Protocol
 
-from app.link.active import MotionTracker
-from app.link.jog import JogMachine
-from app.link.poller import Polled, Poller, PollFailed
+from app.link import lifecycle
+from app.link.poller import Polled, PollFailed
 from app.link.supervisor import LinkSupervisor
-from app.models import CommandResult
 
 __all__ = ["PollParts", "poll"]
 
 
-class PollParts(Protocol):
-    """The parts one poll goes through, and where a completed command's result goes."""
+class PollParts(lifecycle.LinkParts, Protocol):
+    """The parts one poll goes through (a failed or silent one may change the link:
+    :mod:`app.link.lifecycle`), and where a completed command's result goes."""
 
-    @property
-    def poller(self) -> Poller: ...
-    @property
-    def supervisor(self) -> LinkSupervisor: ...
-    @property
-    def jog(self) -> JogMachine: ...
-    @property
-    def motion(self) -> MotionTracker: ...
     @property
     def link_up(self) -> bool: ...
-
-    def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None: ...
 
 
 def poll(parts: PollParts) -> None:
@@ -61,12 +51,12 @@ def _failed(parts: PollParts, outcome: PollFailed) -> None:
     a failed transaction go to the supervisor."""
     parts.poller.failed(outcome.error)
     if outcome.silent:
-        parts.supervisor.poll_silent(outcome.error, time.monotonic())
+        lifecycle.silent(parts, outcome.error, time.monotonic())
     elif outcome.transport_failed:
         # A malformed answer is a failed poll: the transport counted it and resynchronised
         # (a TCP link is reopened by the next request); none of its values are published;
         # LINK_LOSS_POLLS of them in a row take the link down like any failed transaction.
-        parts.supervisor.transport_failed(outcome.error)
+        lifecycle.link_failed(parts, outcome.error)
     else:
         return
     parts.poller.report_stats()
@@ -77,13 +67,15 @@ def _answered(parts: PollParts, polled: Polled) -> None:
     the jog, the RTT and the link statistics."""
     poller, tracker = parts.poller, parts.motion
     poller.answered()
-    parts.supervisor.poll_answered()
+    lifecycle.answered(parts)
     if not parts.link_up:
         return
     status, pose = poller.publish_reading(polled)
     canary = polled.reading.canary
     if canary is not None:
-        parts.supervisor.canary_read(canary)
+        failure = parts.supervisor.canary_read(canary)
+        if failure is not None:  # the rearm's write failed on the link
+            lifecycle.link_failed(parts, failure)
     poller.report_foreign(polled.client)
     done = tracker.update(status, pose, polled.answered)
     if done is not None:

@@ -23,11 +23,13 @@ section 7). TeachPad decides per connection (``auto``):
   main link after the transaction in flight: the ordering guarantee -- nothing this host wrote
   before the stop (a move command already on its way) can run after it -- stays the main
   link's. A second stop is harmless; the audit trail records both.
+
+What a Stop writes, where and in what order, and what it ends, is :mod:`app.link.halt`'s (the one
+module of the Stop); this is the line's transport.
 """
 
 from __future__ import annotations
 
-import dataclasses
 import logging
 import socket
 import threading
@@ -38,7 +40,6 @@ from typing import TYPE_CHECKING
 from app.connection import ConnectionSettings
 from app.errors import LinkError, MalformedResponse, ResponseTimeout
 from app.link import frames
-from app.link.client import RobotClient
 from app.link.transport import TrafficRecord
 from app.protocol import registers
 
@@ -46,7 +47,7 @@ if TYPE_CHECKING:
     from app.link.capture import TrafficCapture
     from app.safety.audit import AuditLog
 
-__all__ = ["KEEPALIVE", "PROBATION", "RETRY_DELAYS", "StopLine", "StopSent", "stop_on_a_fresh_connection"]
+__all__ = ["KEEPALIVE", "PROBATION", "RETRY_DELAYS", "StopLine", "StopSent"]
 
 _log = logging.getLogger(__name__)
 
@@ -303,42 +304,3 @@ class StopLine:
         if function & 0x80:
             raise LinkError(f"the controller refused a request on the stop line (exception {data[0]})")
         return buf
-
-
-def stop_on_a_fresh_connection(
-    settings: ConnectionSettings,
-    *,
-    audit: AuditLog | None,
-    capture: TrafficCapture,
-    ratio_zero: bool,
-    again_after: float = 0.0,
-) -> float:
-    """Open a new connection to the controller of ``settings``, write ``441 <- 1`` on it, close it;
-    the send's ``time.monotonic()``. Raises the :class:`~app.errors.TeachPadError` of the connect
-    or of the write (:class:`~app.errors.WriteBlocked` in monitor-only mode: nothing is sent).
-
-    Worker thread (it waits for the connect and the answer, each at most the link timeout). The
-    write passes the client's write guard (audited) and its frames go to the traffic capture.
-    ``ratio_zero``: a jog may be under way (teach mode was on when the link went): GV203 <- 0 goes
-    out right after the stop, the vendor's own jog stop. ``again_after``: a write of the old link
-    without its answer may still be acted on until then (``time.monotonic()``; a controller takes
-    a request within the timeout or not at all): when that is later than this stop, a second stop
-    goes out on the same connection once it has passed, so nothing sent before the Stop runs after
-    it (as :func:`app.cli.context.stop_on_a_fresh_link` does after Ctrl-C)."""
-    client = RobotClient(dataclasses.replace(settings, retries=0))
-    client.audit = audit
-    capture.attach(client)
-    try:
-        if not settings.monitor_only:  # (monitor-only: the write guard refuses it, audited, nothing opened)
-            client.connect()
-        sent = time.monotonic()
-        client.stop()
-        if ratio_zero:
-            client.teach_set_ratio(0.0)
-        if again_after > sent:
-            time.sleep(max(0.0, again_after - time.monotonic()))
-            client.stop()
-        return sent
-    finally:
-        capture.detach(client)
-        client.close()

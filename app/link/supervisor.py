@@ -1,14 +1,18 @@
-"""The link supervisor: connect, back off and retry, notice silence and restarts (worker thread).
+"""The link supervisor: the client and the link's state, its decisions on connect, silence,
+failures and restarts (worker thread). It calls no other part: each method says what happened
+(returns it) and :mod:`app.link.lifecycle` hands it on to the jog, the poller, the upload and the
+worker's timers in the order docs/DESIGN.md describes, as :mod:`app.link.sequence` does a poll's.
 
-* **Connect**: open, read status and pose, make jogging safe, write the restart canary, go live
-  (``CONNECTED``), then the queued jobs run.
+* **Connect**: open, read status and pose (:meth:`LinkSupervisor.open`), the jog made safe, go
+  live (:meth:`LinkSupervisor.go_live`), the restart canary, ``CONNECTED``; then the queued jobs run.
 * **Not answering**: a poll that times out with the link still open shows ``NOT_ANSWERING`` at
   once (the held jog is dropped; ratio 0 goes out as soon as the controller answers again); a
   good poll shows ``CONNECTED`` again. Silence lasting :data:`app.timing.NOT_ANSWERING_DOWN_AFTER`
-  declares the link down.
+  declares the link down (:meth:`LinkSupervisor.poll_silent` says which).
 * **Link loss**: :data:`app.timing.LINK_LOSS_POLLS` failed transactions in a row (refused, reset,
-  command timeouts) declare the link ``DOWN`` at once; reconnection follows
-  :data:`app.timing.RECONNECT_BACKOFF` by itself and ends with ``controllerReconnected``.
+  command timeouts) declare the link ``DOWN`` at once (:meth:`LinkSupervisor.transport_failed`
+  says so); reconnection follows :data:`app.timing.RECONNECT_BACKOFF` by itself
+  (:meth:`LinkSupervisor.down` gives the delay) and ends with ``controllerReconnected``.
 * **Restart canary**: a random token in a spare GV, read back on the clock poll; 0 means the
   controller restarted under a live link (``controllerRestarted``: a restart clears GV0..GV99);
   another nonzero value is another master's token (a sign of another master, not a restart;
@@ -25,23 +29,26 @@
 from __future__ import annotations
 
 import dataclasses
+import enum
 import logging
 import random
 import time
+from typing import Protocol
 
 from app import timing
 from app.connection import ConnectionSettings
 from app.errors import LinkError, Reason, ResponseTimeout, TeachPadError
-from app.link.active import MotionTracker
 from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
 from app.link.foreign import ForeignSighting
-from app.link.host import WorkerHost
 from app.link.types import ConnectionState, ControllerIdentity, LinkState, Operation
+from app.models import ControllerStatus, Pose
 from app.protocol import registers
 from app.protocol.registers import UPLOAD_POSE_GV
+from app.safety.audit import AuditLog
+from app.safety.caps import MotionCaps
 
-__all__ = ["Cause", "LinkSupervisor", "check_canary_gv"]
+__all__ = ["Cause", "LinkSupervisor", "Opened", "Silence", "SupervisorOutputs", "check_canary_gv"]
 
 #: Why the link changed: the typed error (its reason goes to the GUI), or only English text
 #: (the link-loss reason without a detail then).
@@ -59,17 +66,41 @@ def check_canary_gv(canary_gv: int | None) -> None:
         )
 
 
-class LinkSupervisor:
-    """Owns the client and the link state."""
+class SupervisorOutputs(Protocol):
+    """What the supervisor emits (the worker's signals); no part, no timer."""
 
-    def __init__(
-        self, host: WorkerHost, canary_gv: int | None, *, tracker: MotionTracker, capture: TrafficCapture
-    ) -> None:
-        """``tracker``: the command under way (its outcome unknown when the link goes);
-        ``capture``: the traffic recorder, attached to each new client."""
+    def publish_connection(self, state: ConnectionState) -> None: ...
+    def publish_restarted(self) -> None: ...
+    def emit_error(
+        self, operation: str, message: str, request_id: int | None = -1, reason: Reason | None = None
+    ) -> None: ...
+
+
+@dataclasses.dataclass(frozen=True, slots=True)
+class Opened:
+    """A connection attempt that read the controller (:meth:`LinkSupervisor.open`)."""
+
+    client: RobotClient
+    status: ControllerStatus
+    pose: Pose
+    ever_connected: bool  # a reconnection: a jog left running by the lost link is stopped first
+
+
+class Silence(enum.Enum):
+    """What a silent poll means (:meth:`LinkSupervisor.poll_silent`)."""
+
+    BEGAN = "began"  # NOT_ANSWERING now: the held jog is dropped
+    GOES_ON = "goes on"  # still silent, not for long enough to declare the link down
+    LOST = "lost"  # silent for NOT_ANSWERING_DOWN_AFTER: the link is lost
+
+
+class LinkSupervisor:
+    """Owns the client and the link state; decides, and returns what it decided."""
+
+    def __init__(self, out: SupervisorOutputs, canary_gv: int | None, *, capture: TrafficCapture) -> None:
+        """``out``: the signals it emits; ``capture``: the traffic recorder, attached to each new client."""
         check_canary_gv(canary_gv)
-        self._host = host
-        self._tracker = tracker
+        self._out = out
         self._capture = capture
         self.canary_gv = canary_gv
         self.client: RobotClient | None = None
@@ -102,75 +133,66 @@ class LinkSupervisor:
         if new != self.state:
             self.state = new
             _log.info("link %s %s%s", new.endpoint, state.value, f": {message}" if message else "")
-            self._host.publish_connection(new)
+            self._out.publish_connection(new)
 
     # --- connecting ----------------------------------------------------------------------
-    def connect_to(self, settings: ConnectionSettings) -> None:
-        host = self._host
-        # Jobs queued since the GUI asked for this connection run once it is up.
-        self.close_link(Operation.CONNECT, LinkState.DISCONNECTED, "", emit=False, fail_queued=False)
+    def begin(self, settings: ConnectionSettings, *, audit: AuditLog | None, caps: MotionCaps | None) -> None:
+        """A new connection (the last one closed): a new client for ``settings`` (CONNECTING is
+        the caller's to say, once the jog has forgotten the last connection's teach mode)."""
         self.settings = settings
         self.client = RobotClient(settings)
-        self.client.audit = getattr(host, "audit", None)  # the audit trail records every write
-        self.client.caps = host.caps  # reduced-speed mode's caps
+        self.client.audit = audit  # the audit trail records every write
+        self.client.caps = caps  # reduced-speed mode's caps
         # another master's parameter / command writes: the shared registers read with a status
         # read once a clock period (polls, and the reads of uploads and command waits alike)
         self.client.watch_shared_every = timing.CLOCK_POLL_PERIOD
         self._capture.attach(self.client)
         self._ever_connected = False
         self._backoff_index = 0
-        host.jog.reset()
-        self.set_state(LinkState.CONNECTING, "")
-        self.try_connect()
 
-    def try_connect(self) -> None:
-        """One connection attempt: open, read status and pose, make jogging safe, go live."""
-        host = self._host
+    def open(self) -> Opened | None:
+        """One connection attempt: open, read status and pose (None: nothing to attempt). Raises
+        the :class:`TeachPadError` of the attempt (then :meth:`down` gives the retry's delay)."""
         client = self.client
-        if host.closed or client is None or self.link_up:
-            return
-        try:
-            client.close()
-            client.connect()
-            status = client.read_status(with_clock=True)
-            pose = client.read_pose()
-            host.jog.make_teach_safe(status, self._ever_connected)
-        except TeachPadError as exc:
-            self.schedule_reconnect(exc)
-            return
+        if client is None or self.link_up:
+            return None
+        client.close()
+        client.connect()
+        status = client.read_status(with_clock=True)
+        pose = client.read_pose()
+        return Opened(client, status, pose, self._ever_connected)
+
+    def go_live(self) -> bool:
+        """The attempt succeeded (the jog made safe): the link is up. True: a reconnection."""
         self.link_up = True
         self.answering = True
         self._failures = 0
         self._backoff_index = 0
         reconnected = self._ever_connected
         self._ever_connected = True
-        host.poller.reset(time.monotonic())
-        self.identify(client)  # before the GUI hears of the link: a restart from now on is noticed
-        self.set_state(LinkState.CONNECTED, "")
-        host.poller.publish(pose, status)
-        if reconnected:
-            host.publish_reconnected()
-        host.start_polling()
-        host.run_jobs()
+        return reconnected
 
-    def schedule_reconnect(self, cause: Cause, prefix: str = "") -> None:
+    def down(self, cause: Cause, prefix: str = "") -> float:
+        """DOWN with ``cause``; the delay (s) before the next attempt (the backoff's next step)."""
         backoff = timing.RECONNECT_BACKOFF
         delay = backoff[min(self._backoff_index, len(backoff) - 1)]
         self._backoff_index += 1
         self.set_state(LinkState.DOWN, prefix + str(cause), self._reason(cause))
-        if not self._host.closed:
-            self._host.start_reconnect(delay)
+        return delay
 
     # --- which controller, the restart canary ------------------------------------------------
-    def identify(self, client: RobotClient) -> None:
+    def identify(self, client: RobotClient) -> TeachPadError | None:
         """Decide the identity of the connection just opened (see the module docstring): keep
-        the canary's token when it proves the same boot as the last connection, else arm a new one."""
+        the canary's token when it proves the same boot as the last connection, else arm a new
+        one. Returns the link's failure to count (:meth:`arm_canary`)."""
         kept = self._surviving_token(client)
+        failure = None
         if kept is not None:
             self.canary_token = kept
         else:
-            self.arm_canary()
+            failure = self.arm_canary()
         self._set_identity()
+        return failure
 
     def _place(self) -> ControllerIdentity | None:
         """The identity of the current settings with the current token (None: no settings)."""
@@ -210,28 +232,28 @@ class LinkSupervisor:
             return None
         return last.boot
 
-    def arm_canary(self, token: float | None = None) -> None:
+    def arm_canary(self, token: float | None = None) -> TeachPadError | None:
         """Write a fresh random token (or ``token``) to the canary GV (not in monitor-only mode,
-        not when disabled)."""
+        not when disabled). A failed write is reported; returned when it is the link's failure
+        (to count against the link: :func:`app.link.lifecycle.link_failed`), else None."""
         self.canary_token = None
         self._canary_foreign = None
         self._rearm_at = None
         client = self.client
         gv = self.canary_gv
         if gv is None or client is None or client.settings.monitor_only:
-            return
+            return None
         if token is None:
             token = self.new_token()
         try:
             client.write_gv(gv, [token])
         except TeachPadError as exc:
-            self._host.emit_error(
+            self._out.emit_error(
                 Operation.CANARY, f"could not write the restart canary GV{gv}: {exc}", None, exc.as_reason()
             )
-            if isinstance(exc, (LinkError, ResponseTimeout)):
-                self.transport_failed(exc)
-            return
+            return exc if isinstance(exc, (LinkError, ResponseTimeout)) else None
         self.canary_token = token
+        return None
 
     @property
     def rearm_pending(self) -> bool:
@@ -241,7 +263,7 @@ class LinkSupervisor:
     def new_token(self) -> float:
         return float(self._random.randint(1, 1 << 23))  # nonzero, exact in float32
 
-    def canary_read(self, value: float) -> None:
+    def canary_read(self, value: float) -> TeachPadError | None:
         """The canary GV as read on the clock poll (issue 19). A restart clears GV0..GV99, so
         only 0 reads as "the controller restarted" (new identity, armed again). Any other value
         than ours was written by another master: not a restart (the identity and the points stay),
@@ -252,13 +274,14 @@ class LinkSupervisor:
         After a restart our fresh token is written only :data:`app.timing.CANARY_REARM_DELAY`
         later, while the canary still reads 0: another TeachPad reading once a second sees the 0
         (the restart) too, instead of our token. When another host's token shows first, it
-        stands for this boot and nothing is written."""
+        stands for this boot and nothing is written. Returns the link's failure to count (the
+        rearm's write: :meth:`arm_canary`), else None."""
         if self.canary_token is None:
-            return
-        if self._rearm_at is not None and self._pending_rearm(value):
-            return
+            return None
+        if self._rearm_at is not None:
+            return self._pending_rearm(value)
         if value in (self.canary_token, self._canary_foreign):
-            return
+            return None
         if value != 0.0:
             _log.warning(
                 "restart canary GV%s reads %g instead of %g: another master wrote it (not a restart)",
@@ -270,7 +293,7 @@ class LinkSupervisor:
             client = self.client
             if client is not None:
                 client.foreign.add(ForeignSighting("canary", value, time.monotonic()))
-            return
+            return None
         _log.warning(
             "restart canary GV%s reads 0 instead of %g: the controller restarted",
             self.canary_gv,
@@ -283,57 +306,53 @@ class LinkSupervisor:
         self._set_identity()  # another boot: published before the restart itself, so the GUI's
         if self.link_up:  # points are unknown by the time it hears of the restart
             self.set_state(self.state.state, self.state.message, self.state.reason)
-        self._host.publish_restarted()
+        self._out.publish_restarted()
+        return None
 
-    def _pending_rearm(self, value: float) -> bool:
-        """After a restart, before our token is written: True when ``value`` is dealt with here."""
+    def _pending_rearm(self, value: float) -> TeachPadError | None:
+        """After a restart, before our token is written: ``value`` dealt with here (the rearm's
+        failure to count returned, see :meth:`arm_canary`)."""
         if value == 0.0:
             rearm_at = self._rearm_at
+            failure = None
             if rearm_at is not None and time.monotonic() >= rearm_at:
                 token = self.canary_token
-                self.arm_canary(token)
+                failure = self.arm_canary(token)
                 self._set_identity()  # the same token: the identity does not change
-            return True
+            return failure
         self._rearm_at = None  # another host wrote its token first: it stands for this boot
         self._canary_foreign = value
         client = self.client
         if client is not None:  # (another master is there)
             client.foreign.add(ForeignSighting("canary", value, time.monotonic()))
-        return True
+        return None
 
     # --- failures ----------------------------------------------------------------------
-    def poll_answered(self) -> None:
-        """A good poll: back to CONNECTED after a silence (ratio 0 first if a jog was under way)."""
+    def answering_again(self) -> bool:
+        """A good poll (the failures in a row end). True when it ends a silence: the jog gets
+        its ratio 0 first, then :meth:`set_state` ``CONNECTED`` (:func:`app.link.lifecycle.answered`)."""
         self._failures = 0
         if self.answering:
-            return
+            return False
         self.answering = True
-        try:
-            self._host.jog.controller_answers()
-        except TeachPadError as exc:
-            self._host.emit_error(
-                Operation.JOG_RELEASE, f"could not stop the jog: {exc}", None, exc.as_reason()
-            )
-            if isinstance(exc, (LinkError, ResponseTimeout)):
-                self.transport_failed(exc)
-                if not self.link_up:
-                    return
-        self.set_state(LinkState.CONNECTED, "")
+        return True
 
-    def poll_silent(self, cause: Cause, now: float) -> None:
-        """A poll timed out with the link open: NOT_ANSWERING at once; DOWN when it lasts."""
+    def poll_silent(self, cause: Cause, now: float) -> Silence:
+        """A poll timed out with the link open: NOT_ANSWERING at once; lost when it lasts."""
         if self.answering:
             self.answering = False
             self._silent_since = now
             self.set_state(LinkState.NOT_ANSWERING, str(cause), self._reason(cause))
-            self._host.jog.controller_silent()  # tells the operator itself when a jog was under way
-        elif now - self._silent_since >= timing.NOT_ANSWERING_DOWN_AFTER:
-            self.link_lost(cause)
+            return Silence.BEGAN
+        if now - self._silent_since >= timing.NOT_ANSWERING_DOWN_AFTER:
+            return Silence.LOST
+        return Silence.GOES_ON
 
-    def transport_failed(self, cause: Cause) -> None:
+    def transport_failed(self, cause: Cause) -> bool:
+        """A failed transaction counted; True when they are :data:`app.timing.LINK_LOSS_POLLS`
+        in a row (the link is lost: :func:`app.link.lifecycle.lose_link`)."""
         self._failures += 1
-        if self._failures >= timing.LINK_LOSS_POLLS:
-            self.link_lost(cause)
+        return self._failures >= timing.LINK_LOSS_POLLS
 
     def _reason(self, cause: Cause) -> Reason:
         """The GUI's reason for ``cause``: the typed error's own, else "link lost" (its English
@@ -343,78 +362,27 @@ class LinkSupervisor:
         settings = self.settings
         return Reason("link_lost", {"endpoint": settings.endpoint} if settings else {})
 
-    def link_lost(self, cause: Cause) -> None:
-        """Declare the link down at once; the reconnect timer takes over."""
-        if not self.link_up:
-            return
-        host = self._host
+    def lost(self) -> None:
+        """The link is declared down (the jog, the upload and the queue are told by the caller);
+        the canary stops being checked."""
         self.link_up = False
         self.answering = True
         self._failures = 0
-        host.stop_polling()
-        host.jog.link_lost()
         self.canary_token = None
-        host.uploader.end(f"link lost: {cause}")
-        self._fail_active(
-            "link lost while the command was under way; its outcome is unknown", "outcome_unknown_link_lost"
-        )
-        host.fail_queued("the link to the controller is down: not sent", "queued_link_down")
+
+    def drop_client(self) -> None:
+        """After a loss: the client's connection closed (the client kept for the next attempt)."""
         if self.client is not None:
             self.client.close()
         self._backoff_index = 0
-        self.schedule_reconnect(cause, "link lost: ")
 
-    def close_link(
-        self,
-        operation: str,
-        state: LinkState,
-        message: str,
-        *,
-        emit: bool = True,
-        fail_queued: bool = True,
-        short: bool = False,
-    ) -> None:
-        """Stop jogging and switch teach off (if the controller answers), close, stop retrying.
-
-        ``short`` (shutdown): those safety transactions wait at most the poll timeout each, so a
-        dead controller cannot hold the window's close for the request timeout."""
-        host = self._host
-        host.stop_reconnect()
-        host.stop_polling()
+    def close(self) -> None:
+        """The link closed for good (disconnect, new settings, shutdown): the client goes."""
         client = self.client
-        if client is not None and self.link_up and not client.settings.monitor_only:
-            try:
-                if short:
-                    with client.io_timeout(client.settings.effective_poll_timeout):
-                        host.jog.stop_jog_and_teach()
-                else:
-                    host.jog.stop_jog_and_teach()
-            except TeachPadError as exc:
-                host.emit_error(operation, f"could not stop teach mode: {exc}", None, exc.as_reason())
         self.canary_token = None
-        host.uploader.end(f"{operation}: the link was closed")
-        self._fail_active(
-            f"{operation}: the link was closed while the command was under way", "outcome_unknown_link_closed"
-        )
-        if fail_queued:
-            host.fail_queued(f"{operation}: the link was closed: not sent", "queued_link_closed")
         self.link_up = False
         self.answering = True
         if client is not None:
             self._capture.detach(client)
             client.close()
         self.client = None
-        host.poller.forget()
-        if emit:
-            self.set_state(state, message)
-
-    def _fail_active(self, message: str, code: str) -> None:
-        active = self._tracker.take()
-        if active is not None:
-            # its outcome is unknown: said so, and recorded so against its command in the audit
-            result = active.completion.unknown(
-                time.monotonic(),
-                message=f"{active.operation}: {message}",
-                reason=Reason(code, {"operation": active.operation}),
-            )
-            self._host.emit_result(result, active.request_id)

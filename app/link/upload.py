@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 from app import timing
 from app.errors import InvalidInput, LinkError, TeachPadError, WriteBlocked
 from app.link.client import RobotClient
-from app.link.host import WorkerHost
+from app.link.host import UploadLink
 from app.link.progress import PointUploaded, UploadProgress
 from app.link.types import Operation
 from app.link.upload_driver import UploadCounts, Verdict, batch_end, group_by_tool, send_batch
@@ -109,7 +109,7 @@ def check_upload_items(client: RobotClient, raw: Sequence[RawItem]) -> list[Uplo
 class Uploader:
     """The running upload (one at a time)."""
 
-    def __init__(self, host: WorkerHost, halt_count: Callable[[], int] = lambda: 0) -> None:
+    def __init__(self, host: UploadLink, halt_count: Callable[[], int] = lambda: 0) -> None:
         """``halt_count`` (any thread's stops and cancels so far, growing): once it has grown
         since the upload began, a stop or cancel is on its way and nothing more is written."""
         self._host = host
@@ -136,7 +136,7 @@ class Uploader:
                 )
             )
             return False
-        host.jog.leave_teach(host.poller.last_status)
+        host.leave_teach()
         self.run = WorkerUpload(host.request_id, items, halts_at_start=self._halt_count())
         self._note_progress(self.run, force=True)
         return True
@@ -174,7 +174,7 @@ class Uploader:
         if transport_error is not None:
             upload.end = upload.end or transport_error
             if host.link_up:  # a link already lost or closed (an urgent job meanwhile) counts no more
-                host.supervisor.transport_failed(transport_error)
+                host.link_failed(transport_error)
         self._note_progress(upload)
 
     def _send_chunk(
@@ -191,7 +191,7 @@ class Uploader:
                 [(pid, pose) for pid, pose, _ in items],
                 items[0][2],
                 functools.partial(self._between_points, upload, start),
-                canary_gv=host.supervisor.canary_gv,
+                canary_gv=host.canary_gv,
                 halted=functools.partial(self._halted, upload),  # no staging write, no next point
                 between=self._between_reads,
             )

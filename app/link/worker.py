@@ -4,7 +4,11 @@
 (created in the worker thread, like its timers). The GUI thread never waits for the network:
 requests go into a thread-safe :class:`~app.link.jobs.JobQueue` and results come back as signals.
 The worker only composes its parts, each a Qt-free class in its own module, all on the worker
-thread and calling back through :class:`~app.link.host.WorkerHost`:
+thread; each gets only what it uses (:mod:`app.link.host`: the client, ``run_urgent``, the
+emitters, a narrow view or callable of another part), none gets the worker with its siblings.
+The worker sequences them: a poll's outcome through :mod:`app.link.sequence`, the link's changes
+(connect, silence, failures, loss, close) through :mod:`app.link.lifecycle`, the supervisor
+deciding and the other parts told in turn:
 
 * :class:`~app.link.supervisor.LinkSupervisor` -- connect, backoff, link loss, *not answering*,
   the restart canary.
@@ -30,12 +34,14 @@ thread and calling back through :class:`~app.link.host.WorkerHost`:
 
 Requests are operations as data (:mod:`app.link.ops`): :meth:`RobotWorker.submit` queues one
 and returns its ticket (request id); the worker runs each through one table, operation type ->
-handler (``handlers``). The handlers of the short commands (``stop`` ...) are in
+handler (``handlers``). The handlers of the short commands (``pause`` ...) are in
 :class:`~app.link.commands.WorkerCommands`, those of the long ones in
-:class:`~app.link.motion.MotionCommands`: parts the worker composes, like the others.
+:class:`~app.link.motion.MotionCommands`, the Stop's in :class:`~app.link.halt.StopJob`: parts
+the worker composes, like the others.
 
-Stop latency: :meth:`RobotWorker.submit` of a :class:`~app.link.ops.Stop` writes the stop from
-the calling thread on the stop line (:mod:`app.link.stop_line`) when there is one; the stop job
+Stop latency (everything a Stop does: :mod:`app.link.halt`): :meth:`RobotWorker.submit` of a
+:class:`~app.link.ops.Stop` writes the stop from the calling thread on the stop line
+(:func:`~app.link.halt.post_stop`, :mod:`app.link.stop_line`) when there is one; the stop job
 then writes it on the main link too, after the transaction in flight (ordering), and reads the
 line's answer. Without a line the GUI thread waits (GIL released, at most
 :data:`STOP_HANDOFF_WAIT`) for the worker to write it.
@@ -72,10 +78,12 @@ from app.errors import (
     TeachPadError,
     WriteBlocked,
 )
+from app.link import lifecycle
 from app.link.active import MotionTracker
 from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
 from app.link.commands import WorkerCommands
+from app.link.halt import StopJob, post_stop
 from app.link.jobs import Job, JobQueue
 from app.link.jog import JogMachine, PreemptedError
 from app.link.motion import MotionCommands
@@ -87,7 +95,7 @@ from app.link.sequence import poll
 from app.link.state import PollUpdate
 from app.link.stats import LinkStats
 from app.link.stop_line import StopLine
-from app.link.supervisor import LinkSupervisor
+from app.link.supervisor import Cause, LinkSupervisor
 from app.link.transport import TrafficRecord
 from app.link.types import ConnectionState, LinkState, Operation, UnconfirmedHalt, WorkerError
 from app.link.upload import Uploader
@@ -163,9 +171,7 @@ class RobotWorker(QObject):
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
         self.poller = Poller(self, self.motion)
-        self.supervisor = LinkSupervisor(  # raises on a bad canary GV
-            self, canary_gv, tracker=self.motion, capture=self.capture
-        )
+        self.supervisor = LinkSupervisor(self, canary_gv, capture=self.capture)  # raises on a bad canary GV
         self.stop_line = StopLine()  # the stop's own connection; send_stop from any thread
         # a stop counts on the stop line before its 441 goes out, then (and a cancel) in the queue
         self.uploader = Uploader(self, lambda: self.stop_line.stops_requested + self._jobs.halts)
@@ -179,7 +185,16 @@ class RobotWorker(QObject):
             self, self.motion, self.jog, self.poller, uploading=lambda: self.uploader.run is not None
         )
         self.use_stop_line = True  # False: every stop goes through the queue (set before connecting)
-        self.commands = WorkerCommands(self)  # the short commands' handlers
+        self.stop_job = StopJob(  # everything a Stop does: app/link/halt.py
+            self,
+            line=self.stop_line,
+            capture=self.capture,
+            jog=self.jog,
+            tracker=self.motion,
+            end_upload=self.uploader.end,
+        )
+        # the short commands' handlers
+        self.commands = WorkerCommands(self, jog=self.jog, motions=self.motions, uploader=self.uploader)
         self.register_reads = RegisterReads(self)  # write-free block reads (the register-map self-test)
         self.watch_list = WatchListReader(self, self.watchRead.emit)  # read after the pose (poller.py)
         self.poller.watch_list = self.watch_list
@@ -189,7 +204,8 @@ class RobotWorker(QObject):
         """The one table: operation type -> what runs it (worker thread); each part registers
         the operations it runs."""
         handlers = Handlers()
-        self.commands.register(handlers)  # the short ones (stop, pause, the jog ...)
+        self.stop_job.register(handlers)  # the Stop
+        self.commands.register(handlers)  # the short ones (pause, the jog ...)
         self.motions.register(handlers)  # the long ones (step, move to point ...)
         self.register_reads.register(handlers)  # block reads
         self.watch_list.register(handlers)  # the watch list and an engineer's write of a value
@@ -204,19 +220,19 @@ class RobotWorker(QObject):
         answer, the bookkeeping). Without a stop line, from another thread, this waits (GIL
         released) until the worker has written it, at most :data:`STOP_HANDOFF_WAIT`, so nothing
         of the caller's runs first. The stop runs whatever the link's state: without a link it
-        goes over a fresh connection to the last controller (``WorkerCommands.stop``)."""
+        goes over a fresh connection to the last controller (:class:`~app.link.halt.StopJob`)."""
         if not isinstance(op, Stop):
             request_id = self._jobs.put(Job(op))
             self._wake.emit()
             return request_id
-        on_line = self.stop_line.send_stop()
-        sent = threading.Event()
-        request_id = self._jobs.put(Job(op, sent=sent, on_line=on_line))
-        self._wake.emit()
-        worker = self._worker_ident
-        if on_line is None and worker is not None and worker != threading.get_ident():
-            sent.wait(STOP_HANDOFF_WAIT)
-        return request_id
+        return post_stop(
+            op,
+            self.stop_line,
+            self._jobs.put,
+            self._wake.emit,
+            worker_thread=self._worker_ident,
+            handoff_wait=STOP_HANDOFF_WAIT,
+        )
 
     # --- lifecycle (worker thread) ------------------------------------------------------
     @Slot()
@@ -240,20 +256,20 @@ class RobotWorker(QObject):
         """(Re)connect with ``settings``; retries by itself until :meth:`disconnect_link`."""
         if not self.closed:
             self.stop_line.reset(settings if self.use_stop_line else None)
-            self.supervisor.connect_to(settings)
+            lifecycle.connect(self, settings)
 
     @Slot()
     def disconnect_link(self) -> None:
         """Stop jogging, switch teach off, close the link, stop retrying."""
         if not self.closed:
-            self.supervisor.close_link(Operation.DISCONNECT, LinkState.DISCONNECTED, "")
+            lifecycle.close_link(self, Operation.DISCONNECT, LinkState.DISCONNECTED, "")
 
     @Slot()
     def shutdown(self) -> None:
         """Queued from the GUI: stop motion, close, hand the object back, quit this thread."""
         if self.closed:
             return
-        self.supervisor.close_link(Operation.SHUTDOWN, LinkState.DISCONNECTED, "", short=True)
+        lifecycle.close_link(self, Operation.SHUTDOWN, LinkState.DISCONNECTED, "", short=True)
         self.flush_traffic()  # the close's own frames (teach off) before the thread ends
         self.closed = True
         self._worker_ident = None
@@ -350,6 +366,11 @@ class RobotWorker(QObject):
     def link_up(self) -> bool:
         return self.supervisor.link_up
 
+    @property
+    def last_settings(self) -> ConnectionSettings | None:
+        """The last controller's settings (None: none asked for yet)."""
+        return self.supervisor.settings
+
     def client_or_raise(self) -> RobotClient:
         client = self.supervisor.client
         if client is None or not self.supervisor.link_up:
@@ -359,6 +380,18 @@ class RobotWorker(QObject):
     def poll_if_due(self) -> None:
         if time.monotonic() - self.poller.last_poll >= 1.0 / self._poll_rate():
             self._poll()
+
+    def link_failed(self, cause: Cause) -> None:
+        """A failed transaction counted against the link (lost after too many in a row)."""
+        lifecycle.link_failed(self, cause)
+
+    def leave_teach(self) -> None:
+        """Teach mode off (the jog ended) before a command that moves the arm (an upload)."""
+        self.jog.leave_teach(self.poller.last_status)
+
+    @property
+    def canary_gv(self) -> int | None:
+        return self.supervisor.canary_gv
 
     def start_polling(self) -> None:
         if self._poll_timer is not None:
@@ -461,7 +494,7 @@ class RobotWorker(QObject):
     # --- timers and queued calls (worker thread) ----------------------------------------
     @Slot()
     def _try_connect(self) -> None:
-        self.supervisor.try_connect()
+        lifecycle.try_connect(self)
 
     @Slot()
     def _on_tick(self) -> None:
@@ -571,4 +604,4 @@ class RobotWorker(QObject):
         if isinstance(exc, LinkError | ResponseTimeout | MalformedResponse) and not isinstance(
             exc, WriteBlocked
         ):
-            self.supervisor.transport_failed(exc)
+            self.link_failed(exc)

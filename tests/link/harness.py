@@ -8,6 +8,7 @@ from typing import Any
 
 from app.connection import ConnectionSettings
 from app.errors import LinkError, Reason
+from app.link import lifecycle
 from app.link.active import MotionTracker
 from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
@@ -27,7 +28,8 @@ from app.safety.envelope import EnvelopeViolation
 
 
 class PartsHost:
-    """Implements :class:`app.link.host.WorkerHost` without Qt; ``out`` lists (name, payload)."""
+    """Composes the parts as :class:`~app.link.worker.RobotWorker` does, without Qt (the same
+    sequences: :mod:`app.link.sequence`, :mod:`app.link.lifecycle`); ``out`` lists (name, payload)."""
 
     def __init__(self, canary_gv: int | None = None) -> None:
         self.out: list[tuple[str, Any]] = []
@@ -42,7 +44,7 @@ class PartsHost:
         self.capture = TrafficCapture()
         self.motion = MotionTracker()
         self.poller = Poller(self, self.motion)
-        self.supervisor = LinkSupervisor(self, canary_gv, tracker=self.motion, capture=self.capture)
+        self.supervisor = LinkSupervisor(self, canary_gv, capture=self.capture)
         self.uploader = Uploader(self)
         self.jog = JogMachine(
             self,
@@ -54,6 +56,19 @@ class PartsHost:
     def poll(self) -> None:
         """One poll, in the worker's order (app/link/sequence.py)."""
         poll(self)
+
+    # --- the link's changes, in the worker's order (app/link/lifecycle.py) -------------------
+    def connect_to(self, settings: ConnectionSettings) -> None:
+        lifecycle.connect(self, settings)
+
+    def try_connect(self) -> None:
+        lifecycle.try_connect(self)
+
+    def link_failed(self, cause: Any) -> None:
+        lifecycle.link_failed(self, cause)
+
+    def link_lost(self, cause: Any) -> None:
+        lifecycle.lose_link(self, cause)
 
     # --- what the parts call ---------------------------------------------------------------
     @property
@@ -80,6 +95,13 @@ class PartsHost:
 
     def poll_if_due(self) -> None:
         pass
+
+    def leave_teach(self) -> None:
+        self.jog.leave_teach(self.poller.last_status)
+
+    @property
+    def canary_gv(self) -> int | None:
+        return self.supervisor.canary_gv
 
     def fail_queued(self, message: str, code: str | None = None) -> None:
         self.out.append(("failQueued", message))
@@ -183,8 +205,8 @@ class PartsHost:
         # A roomy poll timeout: only the tests about silence make it short (the box may be loaded).
         values: dict[str, Any] = {"host": "127.0.0.1", "port": sim.port, "timeout": 1.0, "poll_timeout": 1.0}
         values.update(overrides)
-        self.supervisor.connect_to(ConnectionSettings(**values))
+        lifecycle.connect(self, ConnectionSettings(**values))
         assert self.link_up, self.out
 
     def close(self) -> None:
-        self.supervisor.close_link("shutdown", LinkState.DISCONNECTED, "")
+        lifecycle.close_link(self, "shutdown", LinkState.DISCONNECTED, "")

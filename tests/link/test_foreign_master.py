@@ -87,8 +87,8 @@ def test_a_reconnect_keeps_the_boot_when_the_canary_holds_the_token_another_mast
         one = _identity(parts)
         other.write_gv(CANARY_GV, [4242.0])
         parts.poll()
-        parts.supervisor.link_lost("test")
-        parts.supervisor.try_connect()
+        parts.link_lost("test")
+        parts.try_connect()
         assert _identity(parts).same_boot(one)
     finally:
         other.close()

@@ -1,5 +1,5 @@
 """A Stop the main connection does not take while the separate stop connection does
-(app/link/commands.py ``_stopped_on_the_line_only``), through RobotLink against the simulator.
+(app/link/halt.py ``StopJob._stopped_on_the_line_only``), through RobotLink against the simulator.
 
 The simulator refuses ``441`` on the main link's connection only (``set_exception(...,
 connection=...)``): the controller took the stop on the stop line, so the arm was stopped. The

@@ -7,7 +7,6 @@ from typing import Any
 import pytest
 
 from app import timing
-from app.link.active import MotionTracker
 from app.link.capture import TrafficCapture
 from app.link.supervisor import LinkSupervisor, check_canary_gv
 from app.link.types import ControllerIdentity, LinkState
@@ -29,9 +28,9 @@ def test_unreachable_backs_off(sim_factory: Any, monkeypatch: pytest.MonkeyPatch
     parts = PartsHost()
     from app.connection import ConnectionSettings
 
-    parts.supervisor.connect_to(ConnectionSettings(host="127.0.0.1", port=port, timeout=0.2))
+    parts.connect_to(ConnectionSettings(host="127.0.0.1", port=port, timeout=0.2))
     for _ in range(2):
-        parts.supervisor.try_connect()
+        parts.try_connect()
     assert parts.states() == [LinkState.CONNECTING, LinkState.DOWN]
     assert parts.reconnect_delays == [0.1, 0.2, 0.2]  # the last delay repeats
     parts.close()
@@ -40,17 +39,17 @@ def test_unreachable_backs_off(sim_factory: Any, monkeypatch: pytest.MonkeyPatch
 def test_transport_failures_in_a_row_take_the_link_down_and_fail_the_queue(host: PartsHost, sim: Any) -> None:
     host.connect(sim)
     for _ in range(timing.LINK_LOSS_POLLS - 1):
-        host.supervisor.transport_failed("reset")
+        host.link_failed("reset")
     assert host.link_up
-    host.supervisor.transport_failed("reset")
+    host.link_failed("reset")
     assert not host.link_up and host.states()[-1] is LinkState.DOWN
     assert host.of("failQueued") == ["the link to the controller is down: not sent"]
 
 
 def test_reconnect_after_a_loss_says_reconnected(host: PartsHost, sim: Any) -> None:
     host.connect(sim)
-    host.supervisor.link_lost("test")
-    host.supervisor.try_connect()
+    host.link_lost("test")
+    host.try_connect()
     assert host.states()[-2:] == [LinkState.DOWN, LinkState.CONNECTED]
     assert host.names().count("controllerReconnected") == 1
 
@@ -74,7 +73,7 @@ def test_the_canary_must_be_a_spare_gv() -> None:
     with pytest.raises(ValueError, match=r"GV0\.\.GV5"):
         check_canary_gv(3)
     with pytest.raises(ValueError):
-        LinkSupervisor(PartsHost(), 2, tracker=MotionTracker(), capture=TrafficCapture())
+        LinkSupervisor(PartsHost(), 2, capture=TrafficCapture())
 
 
 # --- which controller, which boot (issue 18) -----------------------------------------------------
@@ -96,14 +95,14 @@ def test_every_connect_says_which_controller_and_which_boot(sim_factory: Any) ->
         assert one.boot == parts.supervisor.canary_token and one.boot is not None
         # lost and back, the same boot: the canary still holds our token (read, never written again)
         canary_writes = len(first.writes_to(198))
-        parts.supervisor.link_lost("test")
+        parts.link_lost("test")
         assert parts.of("connectionChanged")[-1].controller is None  # not connected: no controller
-        parts.supervisor.try_connect()
+        parts.try_connect()
         assert _controller(parts).same_boot(one) and len(first.writes_to(198)) == canary_writes
         # restarted while the link was down: the same place, another boot (a new token written)
-        parts.supervisor.link_lost("test")
+        parts.link_lost("test")
         first.restart_controller()
-        parts.supervisor.try_connect()
+        parts.try_connect()
         restarted = _controller(parts)
         assert restarted.same_place(one) and not restarted.same_boot(one)
         assert len(first.writes_to(198)) == canary_writes + 1

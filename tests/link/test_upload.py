@@ -181,7 +181,7 @@ def test_a_stop_ends_the_point_in_flight_at_once_when_its_result_never_shows(
     sim = sim_factory(command_latency=60.0)
     host.connect(sim)
 
-    def stop() -> None:  # what the worker's stop job does first (app/link/commands.py)
+    def stop() -> None:  # what the worker's stop job does first (app/link/halt.py)
         host.client_or_raise().stop()
         host.uploader.end("stopped")
 
@@ -222,7 +222,7 @@ def test_a_link_lost_between_two_reads_ends_the_point_without_another_read(
     _long_point_timeouts(monkeypatch)
     sim = sim_factory(command_latency=60.0)
     host.connect(sim)
-    poster = _queue_when_in_flight(host, sim, lambda: host.supervisor.link_lost("the test cut it"))
+    poster = _queue_when_in_flight(host, sim, lambda: host.link_lost("the test cut it"))
     elapsed = _run_upload(host, 3)
     poster.join(1.0)
     assert elapsed < 2.0

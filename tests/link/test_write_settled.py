@@ -1,5 +1,5 @@
 """``RegisterClient.writes_settled_before``: what the stop-line-only Stop relies on (every write of
-the main link answered before the line's stop went out; app/link/commands.py), against the
+the main link answered before the line's stop went out; app/link/halt.py), against the
 simulator: a write under way, answered, refused, without its answer, and Stop's own 441."""
 
 from __future__ import annotations
