@@ -25,11 +25,8 @@ pytestmark = pytest.mark.timeout(60)
 
 @pytest.fixture
 def proxy(sim: Any) -> Iterator[GarblingProxy]:
-    p = GarblingProxy(sim.port)
-    try:
+    with GarblingProxy(sim.port) as p:
         yield p
-    finally:
-        p.close()
 
 
 @pytest.mark.parametrize("garbled", [1, 2], ids=["one attempt", "two attempts in a row"])
