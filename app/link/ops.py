@@ -271,7 +271,7 @@ class CancelUpload(LinkOp):
 @dataclass(frozen=True)
 class ReadRegisters(LinkOp):
     """Read whole register blocks (start, count) with 0x03, nothing written; the worker's
-    ``registersRead`` carries what was read (:class:`~app.link.register_reads.RegisterBlocks`).
+    ``progressed`` carries what was read, under its ticket (:class:`~app.link.progress.RegisterBlocks`).
     A block the controller refuses is kept as refused; the others are still read."""
 
     operation: ClassVar[str] = Operation.READ_REGISTERS

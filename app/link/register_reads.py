@@ -10,42 +10,15 @@ answer, a malformed one) ends the reads and is raised, as every read of the link
 from __future__ import annotations
 
 import time
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Sequence
 from typing import Protocol
 
 from app.errors import ModbusExceptionError
 from app.link.ops import Handlers, ReadRegisters
+from app.link.progress import Progress, RegisterBlocks
 from app.protocol.exceptions import GATEWAY_EXCEPTIONS
 
-__all__ = ["BlockReader", "RegisterBlocks", "RegisterReads", "RegistersHost", "read_blocks"]
-
-
-@dataclass(frozen=True)
-class RegisterBlocks:
-    """What a :class:`~app.link.ops.ReadRegisters` read: ``values`` register -> value of every
-    block read, ``refused`` first register of a refused block -> its Modbus exception code,
-    ``read_at`` the PC's clock (``time.time()``) when the first block was asked for."""
-
-    blocks: tuple[tuple[int, int], ...]
-    values: Mapping[int, int] = field(default_factory=dict)
-    refused: Mapping[int, int] = field(default_factory=dict)
-    read_at: float = 0.0
-    request_id: int | None = None
-
-    def block(self, start: int, count: int) -> list[int] | None:
-        """The registers ``start .. start+count-1``, or None when any of them was not read."""
-        try:
-            return [self.values[start + i] for i in range(count)]
-        except KeyError:
-            return None
-
-    def refusal(self, start: int, count: int) -> int | None:
-        """The exception code of a refused block that overlaps ``start .. start+count-1``."""
-        for (first, n), code in ((b, self.refused[b[0]]) for b in self.blocks if b[0] in self.refused):
-            if first < start + count and start < first + n:
-                return code
-        return None
+__all__ = ["BlockReader", "RegisterReads", "RegistersHost", "read_blocks"]
 
 
 class BlockReader(Protocol):
@@ -79,7 +52,7 @@ class RegistersHost(Protocol):
 
     def client_or_raise(self) -> BlockReader: ...
 
-    def publish_registers(self, blocks: RegisterBlocks) -> None: ...
+    def publish_progress(self, ticket: int | None, progress: Progress) -> None: ...
 
 
 class RegisterReads:
@@ -93,6 +66,7 @@ class RegisterReads:
 
     def read(self, op: ReadRegisters) -> None:
         got = read_blocks(self._host.client_or_raise(), op.blocks)
-        self._host.publish_registers(
-            RegisterBlocks(got.blocks, got.values, got.refused, got.read_at, self._host.request_id)
+        ticket = self._host.request_id
+        self._host.publish_progress(
+            ticket, RegisterBlocks(got.blocks, got.values, got.refused, got.read_at, ticket)
         )

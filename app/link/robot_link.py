@@ -70,7 +70,6 @@ class RobotLink(QObject):
     foreignMaster = Signal(str, float)  # noqa: N815
     progressed = Signal(int, object)  # ticket, Progress (app/link/progress.py): a request's progress
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard stopped a jog
-    registersRead = Signal(object)  # noqa: N815 - RegisterBlocks of a ReadRegisters op (its request_id)
     watchRead = Signal(object)  # noqa: N815 - WatchReadings: the watch list's values (app/link/watch_list.py)
 
     _connectRequested = Signal(object)  # noqa: N815
@@ -159,7 +158,6 @@ class RobotLink(QObject):
             (w.foreignMaster, self.foreignMaster),
             (w.progressed, self._on_progress),
             (w.jogGuardStopped, self.jogGuardStopped),
-            (w.registersRead, self.registersRead),
             (w.watchRead, self.watchRead),
             (w.haltChanged, state.set_halt),
             (self._connectRequested, w.connect_to),

@@ -90,7 +90,7 @@ from app.link.motion import MotionCommands
 from app.link.ops import CancelUpload, Handlers, LinkOp, Stop
 from app.link.poller import Poller
 from app.link.progress import Progress
-from app.link.register_reads import RegisterBlocks, RegisterReads
+from app.link.register_reads import RegisterReads
 from app.link.sequence import poll
 from app.link.state import PollUpdate
 from app.link.stats import LinkStats
@@ -139,7 +139,6 @@ class RobotWorker(QObject):
     progressed = Signal(int, object)  # ticket (request id), Progress (app/link/progress.py): an upload's
     jogGuardStopped = Signal(object)  # noqa: N815 - EnvelopeViolation: the jog guard wrote ratio 0
     haltChanged = Signal(object)  # noqa: N815 - UnconfirmedHalt | None: a stop the controller has not confirmed
-    registersRead = Signal(object)  # noqa: N815 - RegisterBlocks: what a ReadRegisters op read
     watchRead = Signal(object)  # noqa: N815 - WatchReadings: the watch list's reads of a poll (none: no list)
     stopped = Signal()  # the worker has closed the link and is quitting its thread (shutdown)
 
@@ -456,10 +455,6 @@ class RobotWorker(QObject):
 
     def publish_halt(self, halt: UnconfirmedHalt | None) -> None:
         self.haltChanged.emit(halt)
-
-    def publish_registers(self, blocks: RegisterBlocks) -> None:
-        self.flush_traffic()  # the reads' frames reach the GUI before what they read
-        self.registersRead.emit(blocks)
 
     def emit_result(self, result: CommandResult, request_id: int | None = -1) -> None:
         """``commandFinished`` with the request id (default: the job being executed)."""

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Final
 
 from app.geometry import abc_to_matrix, rot_x, rot_y, rot_z
-from app.link.register_reads import RegisterBlocks
+from app.link.progress import RegisterBlocks
 from app.protocol import registers
 from app.protocol.codec import WordOrder, decode_floats, registers_to_float
 from app.protocol.datetime_regs import DateTimeLayout, decode_clock

@@ -17,7 +17,8 @@ from app.cli.exit_codes import ExitCode
 from app.cli.main import main
 from app.connection import ConnectionSettings
 from app.link.client import RobotClient
-from app.link.register_reads import RegisterBlocks, read_blocks
+from app.link.progress import RegisterBlocks
+from app.link.register_reads import read_blocks
 from app.protocol.codec import WordOrder
 from app.protocol.datetime_regs import DateTimeLayout
 from app.safety.register_profile import RegisterProfile, save_register_profile

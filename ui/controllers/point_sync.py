@@ -522,7 +522,7 @@ class PointSyncController(QObject):
             return  # an operation that was already given up
         if isinstance(progress, PointUploaded):
             self._on_point_uploaded(progress)
-        else:
+        elif isinstance(progress, UploadProgress):
             self._on_upload_progress(progress)
 
     def _on_point_uploaded(self, point: PointUploaded) -> None:

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 from PySide6.QtCore import QObject, Signal, Slot
 
 from app.link.ops import ReadRegisters
-from app.link.register_reads import RegisterBlocks
+from app.link.progress import Progress, RegisterBlocks
 from app.link.types import ConnectionState, LinkState, WorkerError
 from app.models import CommandResult
 
@@ -49,7 +49,7 @@ class RegisterMapCheck(QObject):
         self.error = ""
         self.after_connect = False
         link.state.connectionChanged.connect(self._on_connection)
-        link.registersRead.connect(self._on_read)
+        link.progressed.connect(self._on_progress)
         link.errorOccurred.connect(self._on_error)
         link.commandFinished.connect(self._on_result)
 
@@ -78,9 +78,9 @@ class RegisterMapCheck(QObject):
         elif not connection.connected and connection.state is not LinkState.NOT_ANSWERING:
             self.report = None
 
-    @Slot(object)
-    def _on_read(self, read: RegisterBlocks) -> None:
-        if self._ticket is None or read.request_id != self._ticket:
+    @Slot(int, object)
+    def _on_progress(self, ticket: int, read: Progress) -> None:
+        if self._ticket is None or ticket != self._ticket or not isinstance(read, RegisterBlocks):
             return
         self._ticket = None
         settings = self._link.settings
