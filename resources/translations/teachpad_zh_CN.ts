@@ -1669,12 +1669,12 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>TeachPad 示教器</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="179" />
+            <location filename="../../ui/window_column.py" line="189" />
             <source>Monitor only: motion controls are disabled</source>
             <translation>仅监视：运动控制已禁用</translation>
         </message>
         <message>
-            <location filename="../../ui/window_column.py" line="183" />
+            <location filename="../../ui/window_column.py" line="193" />
             <source>Not connected: motion controls are disabled</source>
             <translation>未连接：运动控制已禁用</translation>
         </message>
@@ -1700,24 +1700,44 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
         <message>
-            <location filename="../../ui/foreign_words.py" line="16" />
+            <location filename="../../ui/foreign_words.py" line="25" />
             <source>it wrote its own restart token ({value})</source>
             <translation>它写入了自己的重启标记（{value}）</translation>
         </message>
         <message>
-            <location filename="../../ui/foreign_words.py" line="18" />
+            <location filename="../../ui/foreign_words.py" line="27" />
             <source>register {value} changed without a write of TeachPad</source>
             <translation>寄存器 {value} 在 TeachPad 未写入的情况下发生了变化</translation>
         </message>
         <message>
-            <location filename="../../ui/foreign_words.py" line="22" />
+            <location filename="../../ui/foreign_words.py" line="31" />
             <source>a command result TeachPad did not cause (GV291 = {value})</source>
             <translation>出现了并非 TeachPad 引起的指令结果（GV291 = {value}）</translation>
         </message>
         <message>
-            <location filename="../../ui/foreign_words.py" line="30" />
-            <source>Another Modbus master is on this controller: {sign}. It shares the parameter and command registers with TeachPad: its writes can change what ours do. Check who else is connected.</source>
-            <translation>此控制器上还有另一个 Modbus 主站：{sign}。它与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。请检查还有谁连接着控制器。</translation>
+            <location filename="../../ui/foreign_words.py" line="40" />
+            <source>token {value}</source>
+            <translation>重启标记 {value}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/foreign_words.py" line="42" />
+            <source>register {value}</source>
+            <translation>寄存器 {value}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/foreign_words.py" line="44" />
+            <source>GV291 = {value}</source>
+            <translation>GV291 = {value}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/foreign_words.py" line="50" />
+            <source>Another Modbus master is on this controller ({sign}): check who else is connected.</source>
+            <translation>此控制器上还有另一个 Modbus 主站（{sign}）：请检查还有谁连接着控制器。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/foreign_words.py" line="57" />
+            <source>Seen: {sign}. Another master shares the parameter and command registers with TeachPad: its writes can change what ours do.</source>
+            <translation>迹象：{sign}。另一个主站与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。</translation>
         </message>
         <message>
             <location filename="../../ui/main_window.py" line="423" />
