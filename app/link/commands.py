@@ -13,7 +13,15 @@ import time
 from collections.abc import Callable
 from typing import Protocol
 
-from app.errors import LinkError, MalformedResponse, Reason, ResponseTimeout, TeachPadError, WriteBlocked
+from app.errors import (
+    LinkError,
+    MalformedResponse,
+    ModbusExceptionError,
+    Reason,
+    ResponseTimeout,
+    TeachPadError,
+    WriteBlocked,
+)
 from app.link.active import MotionTracker
 from app.link.capture import TrafficCapture
 from app.link.client import RobotClient
@@ -298,7 +306,11 @@ class WorkerCommands:
         client = self._host.client_or_raise()
         if mode is WorkMode.MANUAL:
             self._host.jog.stop_jog_and_teach()
-        client.set_work_mode(mode)
+        try:
+            client.set_work_mode(mode)
+        except ModbusExceptionError as exc:
+            exc.params["mode"] = int(mode)  # the refusal names the mode asked for
+            raise
         self._done(f"work mode: {mode.name.lower()}", Operation.SET_MODE)
 
     def jog_press(self, op: JogPress) -> None:
