@@ -1,14 +1,13 @@
-"""The "another master" banner at 1280×800 (issue 21, the six jog rows): it says what matters in at
-most two lines in either language -- another master is on the controller, the sign, check who else
-is connected -- and the explanation (it shares the registers, its writes change what ours do) is its
-tooltip, as the word-order banner's evidence is. With it up, connected, the six jog rows show whole
-without a scroll bar."""
+"""The "another master" banner at 1280×800 and 1920×1080 (issue 21, the six jog rows): it says
+what matters in at most two lines in either language -- another master is on the controller, the
+sign, check who else is connected -- and the explanation (it shares the registers, its writes change
+what ours do) is its tooltip, as the word-order banner's evidence is. With it up, connected, the
+six jog rows show whole without a scroll bar."""
 
 from __future__ import annotations
 
 import os
 from collections.abc import Callable
-from typing import Any
 
 import pytest
 from PySide6.QtGui import QFontMetrics
@@ -22,7 +21,7 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     project_dialogs_fixture,
     translator_fixture,
 )
-from tests.ui.test_layout import LANGUAGES, LAPTOP, make_window_fixture, settle  # noqa: F401 - fixture
+from tests.ui.test_layout import LANGUAGES, SIZES, make_window_fixture, settle  # noqa: F401 - fixture
 from tests.ui.test_messages import assert_chinese
 from ui.main_window import MainWindow
 
@@ -44,11 +43,12 @@ def wrapped_lines(label: QLabel) -> int:
 
 
 @pytest.mark.parametrize(("what", "value"), SIGNS, ids=[s[0] for s in SIGNS])
+@pytest.mark.parametrize("size", SIZES, ids=lambda s: f"{s[0]}x{s[1]}")
 @pytest.mark.parametrize("language", LANGUAGES)
-def test_the_jog_rows_fit_1280x800_under_the_another_master_banner(
-    make_window: Callable[..., MainWindow], language: str, what: str, value: float, tmp_path: Any
+def test_the_jog_rows_fit_under_the_another_master_banner(
+    make_window: Callable[..., MainWindow], language: str, size: tuple[int, int], what: str, value: float
 ) -> None:
-    window = make_window(language, LAPTOP)
+    window = make_window(language, size)
     column = window.control_column
     jog = window.jog_panel
     assert column.show_foreign_master(what, value)
@@ -56,7 +56,9 @@ def test_the_jog_rows_fit_1280x800_under_the_another_master_banner(
     banner = column.foreign_banner
     assert banner.isVisible()
     if os.environ.get("TEACHPAD_SHOTS"):
-        window.grab().save(os.path.join(os.environ["TEACHPAD_SHOTS"], f"foreign-{language}-{what}.png"))
+        window.grab().save(
+            os.path.join(os.environ["TEACHPAD_SHOTS"], f"foreign-{language}-{size[0]}-{what}.png")
+        )
     assert wrapped_lines(banner) <= 2, (banner.text(), banner.height())
     assert banner.height() >= banner.heightForWidth(banner.width())  # shown whole
     bar = jog.axes_scroll.verticalScrollBar()
