@@ -187,6 +187,26 @@ _TEMPLATES: dict[str, str] = {
     "modbus_exception": QT_TRANSLATE_NOOP(
         "Messages", "The controller refused the request: Modbus exception {exception} ({name})."
     ),
+    # a request the controller refused with a Modbus exception, named (app/link/worker.py): which
+    # one, what it means for the arm and what to do
+    "pause_refused": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Pause refused by the controller (Modbus exception {exception}, {name}): the arm was not paused. "
+        "Press STOP if it must stop now, or press Pause again.",
+    ),
+    "resume_refused": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Resume refused by the controller (Modbus exception {exception}, {name}): the arm stays paused. "
+        "Press Resume again in a moment.",
+    ),
+    "mode_refused": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Switch to {mode} mode refused by the controller (Modbus exception {exception}, {name}): the "
+        "work mode did not change. Switch it again in a moment.",
+    ),
+    "request_refused": QT_TRANSLATE_NOOP(
+        "Messages", "{command} refused by the controller: Modbus exception {exception} ({name})."
+    ),
     # a gateway's 10 / 11 (app/protocol/exceptions.py GATEWAY_EXCEPTIONS): nothing at the unit id
     "modbus_gateway": QT_TRANSLATE_NOOP(
         "Messages",
@@ -279,7 +299,24 @@ _BARE: dict[str, str] = {
     "manual_mode": QT_TRANSLATE_NOOP(
         "Messages", "{operation}: not sent, the controller is not in auto mode."
     ),
+    "pause_refused": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Pause refused by the controller: the arm was not paused. Press STOP if it must stop now, "
+        "or press Pause again.",
+    ),
+    "resume_refused": QT_TRANSLATE_NOOP(
+        "Messages", "Resume refused by the controller: the arm stays paused. Press Resume again in a moment."
+    ),
+    "mode_refused": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Work mode change refused by the controller: the work mode did not change. Switch it again in a moment.",
+    ),
+    "request_refused": QT_TRANSLATE_NOOP("Messages", "{command} refused by the controller."),
 }
+
+# The requests whose refusal (a Modbus exception) has a sentence of its own; any other named
+# request reads "request_refused".
+_REFUSED_REQUESTS = {"pause": "pause_refused", "resume": "resume_refused", "set mode": "mode_refused"}
 
 _RECONNECT = QT_TRANSLATE_NOOP("Messages", "Cannot reconnect to the controller at {endpoint}: {cause}")
 _CONNECT = QT_TRANSLATE_NOOP("Messages", "Cannot connect to the controller at {endpoint}: {cause}")
@@ -451,9 +488,7 @@ def _template_text(reason: Reason) -> str | None:
     """``reason`` in the sentence of the template tables (the bare one when an argument is
     missing), wrapped in the (re)connect sentence when it says which controller."""
     args = reason.args
-    code = reason.code
-    if code == "modbus_exception" and "unit" in args and args.get("exception") in GATEWAY_EXCEPTIONS:
-        code = "modbus_gateway"  # a wrong unit id, most often: said as such
+    code = _sentence_code(reason)
     template = _TEMPLATES.get(code)
     if template is None:
         return None
@@ -461,7 +496,7 @@ def _template_text(reason: Reason) -> str | None:
     try:
         text = _tr(template).format(**fields)
     except KeyError:
-        bare = _BARE.get(reason.code)
+        bare = _BARE.get(code, _BARE.get(reason.code))
         if bare is None:
             return None
         try:
@@ -472,6 +507,19 @@ def _template_text(reason: Reason) -> str | None:
         wrapper = _RECONNECT if args["reconnect"] else _CONNECT
         text = _tr(wrapper).format(endpoint=args["endpoint"], cause=text)
     return text
+
+
+def _sentence_code(reason: Reason) -> str:
+    """The template ``reason`` reads in: its code, but a Modbus exception is said as a wrong unit id
+    (a gateway's 10 / 11 at a unit id) or as the refusal of the request it names."""
+    args = reason.args
+    if reason.code != "modbus_exception":
+        return reason.code
+    if "unit" in args and args.get("exception") in GATEWAY_EXCEPTIONS:
+        return "modbus_gateway"  # a wrong unit id, most often: said as such
+    if "operation" in args:
+        return _REFUSED_REQUESTS.get(str(args["operation"]), "request_refused")
+    return reason.code
 
 
 def result_text(result: CommandResult) -> str:

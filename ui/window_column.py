@@ -20,7 +20,7 @@ from PySide6.QtWidgets import QLabel, QSizePolicy, QTabWidget, QVBoxLayout, QWid
 from app.link.state import RobotState
 from app.link.types import ConnectionState
 from app.protocol.word_order_check import WordOrderVerdict
-from ui.foreign_words import foreign_master_text
+from ui.foreign_words import foreign_master_details, foreign_master_text
 from ui.panels.control_bar import ControlBar
 from ui.panels.jog_panel import JogPanel
 from ui.panels.jog_refusal import MotionRefusalLine
@@ -38,7 +38,7 @@ FOREIGN_BANNER_MS = 15_000
 # The column was part of the window: its texts keep the "MainWindow" translation context.
 BANNER_STYLE = (
     "QLabel { background: #fff1d6; color: #7a4a00; border: 1px solid #ef8f00;"
-    " border-radius: 4px; padding: 4px; font-weight: bold; }"
+    " border-radius: 4px; padding: 2px 4px; font-weight: bold; }"
 )
 
 
@@ -117,8 +117,7 @@ class ControlColumn(QWidget):
         self.tabs.setTabText(1, QCoreApplication.translate("MainWindow", "Step"))
         self.tabs.setTabText(2, QCoreApplication.translate("MainWindow", "Program"))
         self._show_banner()
-        if self._foreign_sign is not None:
-            self.foreign_banner.setText(foreign_master_text(*self._foreign_sign))
+        self._show_foreign_master()
         self._show_word_order()
 
     @Slot(object)
@@ -161,11 +160,18 @@ class ControlColumn(QWidget):
         showing (a new episode)."""
         new = self.foreign_banner.isHidden()
         self._foreign_sign = (what, value)
-        self.foreign_banner.setText(foreign_master_text(what, value))
+        self._show_foreign_master()
         self.foreign_banner.setVisible(True)
         self._foreign_timer.start(FOREIGN_BANNER_MS)
         self._make_room()
         return new
+
+    def _show_foreign_master(self) -> None:
+        """The banner says the sign it keeps in the language in force; its tooltip explains."""
+        if self._foreign_sign is None:
+            return
+        self.foreign_banner.setText(foreign_master_text(*self._foreign_sign))
+        self.foreign_banner.setToolTip(foreign_master_details(*self._foreign_sign))
 
     @Slot()
     def hide_foreign_master(self) -> None:

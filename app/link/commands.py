@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Protocol
 
-from app.errors import Reason
+from app.errors import ModbusExceptionError, Reason
 from app.link.client import RobotClient
 from app.link.jobs import Job
 from app.link.jog import JogMachine
@@ -113,7 +113,11 @@ class WorkerCommands:
         client = self._host.client_or_raise()
         if mode is WorkMode.MANUAL:
             self._jog.stop_jog_and_teach()
-        client.set_work_mode(mode)
+        try:
+            client.set_work_mode(mode)
+        except ModbusExceptionError as exc:
+            exc.params["mode"] = int(mode)  # the refusal names the mode asked for
+            raise
         self._done(f"work mode: {mode.name.lower()}", Operation.SET_MODE)
 
     def jog_press(self, op: JogPress) -> None:

@@ -585,7 +585,8 @@ class RobotWorker(QObject):
         against the link. Monitor-only's refusal before the wire is only an error."""
         if isinstance(exc, ModbusExceptionError):
             text = f"{operation}: {exc}"
-            self.emit_result(CommandResult(None, None, None, False, text, reason=exc.as_reason()))
+            named = Reason(exc.code, {**exc.params, "operation": operation})  # the words name the request
+            self.emit_result(CommandResult(None, None, None, False, text, reason=named))
             return
         if isinstance(exc, CommandRefused):
             status = exc.status

@@ -27,6 +27,8 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, TextIO
 
+from app.safety.roles import PLANT_ROLE
+
 __all__ = [
     "CSV_COLUMNS",
     "FILE_RE",
@@ -293,7 +295,7 @@ class AuditFilter:
     kind: str | None = None
 
     def matches(self, rec: AuditRecord) -> bool:
-        if self.role is not None and rec.role != self.role:
+        if self.role is not None and not role_matches(self.role, rec.role):
             return False
         if self.result is not None and rec.result != self.result:
             return False
@@ -316,6 +318,12 @@ class AuditFilter:
             None if self.start is None else self.start.date() - one,
             None if self.end is None else self.end.date() + one,
         )
+
+
+def role_matches(wanted: str, role: str) -> bool:
+    """A record's ``role`` is the one ``wanted``; the plant (:data:`~app.safety.roles.PLANT_ROLE`)
+    is each of its robots' ``plant (R1)`` (app/gateway/plant.py)."""
+    return role == wanted or (wanted == PLANT_ROLE and role.startswith(f"{PLANT_ROLE} ("))
 
 
 def _cmp_time(a: dt.datetime, b: dt.datetime) -> int:

@@ -84,7 +84,8 @@ class WriteRecord:
 
 @dataclass(frozen=True)
 class SimEvent:
-    """Something the controller did by itself: monotonic time, kind (``"watchdog"``), details."""
+    """Something the controller did by itself: monotonic time, kind (``"watchdog"``; ``"refused"``: a
+    write answered by the exception rule), details."""
 
     t: float
     kind: str

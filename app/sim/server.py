@@ -274,6 +274,8 @@ class SimController:
             return ExcCodes.DEVICE_FAILURE  # not executed; the answer is dropped by _trace_packet
         injected = await self._injected_fault(serial, connection, address, count)
         if injected is not None:
+            if set_values is not None:
+                self._log_refused(function_code, address, injected)
             return injected
         values = None if set_values is None else [int(v) & 0xFFFF for v in set_values]
         if values is not None:
@@ -431,6 +433,18 @@ class SimController:
             drop = len(writes) - WRITE_LOG_LIMIT + WRITE_LOG_LIMIT // 10
             del writes[:drop]
             self.writes_dropped += drop
+
+    def refused_writes(self) -> list[SimEvent]:
+        """The writes the exception rule (:meth:`set_exception`) answered with its exception, not
+        carried out (kind ``"refused"``; detail: function code, address, exception)."""
+        with self.lock:
+            return [e for e in self.events if e.kind == "refused"]
+
+    def _log_refused(self, function_code: int, address: int, code: ExcCodes) -> None:
+        detail = f"write fc=0x{function_code:02X} address={address}: exception {int(code)}"
+        with self.lock:
+            self.events.append(SimEvent(time.monotonic(), "refused", detail))
+        log.info("%s", detail)
 
     def _watchdog_stop(self, reason: str) -> bool:
         """The watchdog fired: ratio 0 (GV203 reads 0 too), teach stays enabled."""

@@ -46,13 +46,13 @@ def test_the_banner_retranslates_while_it_is_shown(
     banner = window.control_column.foreign_banner
     assert banner.isVisibleTo(window)
     english = banner.text()
-    assert english.startswith(
-        "Another Modbus master is on this controller: it wrote its own restart token (4242)"
-    )
+    assert english == "Another Modbus master is on this controller (token 4242): check who else is connected."
+    assert banner.toolTip().startswith("Seen: it wrote its own restart token (4242). Another master shares")
     window.set_language("zh_CN")
     assert translator.language == "zh_CN"
     chinese = banner.text()
-    assert chinese.startswith("此控制器上还有另一个 Modbus 主站：它写入了自己的重启标记（4242）"), chinese
+    assert chinese.startswith("此控制器上还有另一个 Modbus 主站（重启标记 4242）"), chinese
+    assert banner.toolTip().startswith("迹象：它写入了自己的重启标记（4242）。"), banner.toolTip()
     assert banner.isVisibleTo(window)
     window.set_language("en")
     assert banner.text() == english

@@ -1,4 +1,5 @@
 """The audit trail viewer: filter by date, role, command and result; export the rows shown as CSV.
+The role "plant" shows the Sparkplug gateway's records, each robot's (``plant (R1)``).
 
 A command's result is the controller's outcome (done, refused -- with its status code, as
 "refused:13" --, stopped, unknown; see app/link/outcome.py); other writes read ok when answered.
@@ -31,6 +32,7 @@ from PySide6.QtWidgets import (
 from app.points.atomic import atomic_write_bytes
 from app.safety.audit_chain import verify_chain
 from app.safety.audit_read import AuditFilter, AuditRecord, ReadStats, Result, export_csv, query, result_label
+from app.safety.roles import PLANT_ROLE
 from ui.audit_words import command_words, detail_words
 
 DEFAULT_DAYS = 7  # the range shown when the viewer opens
@@ -83,6 +85,8 @@ class AuditModel(QAbstractTableModel):
         if col == "detail":
             return detail_words(r)
         value = str(getattr(r, col))
+        if col == "role" and value.startswith(f"{PLANT_ROLE} (") and value.endswith(")"):
+            return self.tr("plant ({robot})").format(robot=value[len(PLANT_ROLE) + 2 : -1])
         if col in ("role", "kind", "result"):  # the file keeps English keys; the table shows words
             words = self._words().get(value, value)
             label = result_label(r) if col == "result" else value
@@ -136,6 +140,7 @@ class AuditViewer(QDialog):
             ("engineer", self.tr("engineer")),
             ("administrator", self.tr("administrator")),
             ("administrator (cli)", self.tr("administrator (CLI)")),
+            (PLANT_ROLE, self.tr("plant")),  # the gateway's writes, every robot's (plant (R1), ...)
         ):
             self.role_box.addItem(text, name)
         self.command = QLineEdit(self)
