@@ -118,3 +118,6 @@ GATEWAY_CLOCK_PERIOD = 1.0  # s between reads of the controller's clock (with th
 GATEWAY_STOP_WAIT = 2.0  # s a stopping gateway waits for its NDEATH to be sent
 # DDATA kept while the broker is away (sent flagged is_historical when it is back); older ones are dropped
 GATEWAY_HISTORY_LIMIT = 10_000
+
+# --- measured stopping (app/safety/stopping.py; issue 24) ----------------------------------------
+STOP_STILL_TIMEOUT = 5.0  # s after a Stop / jog release within which the arm must be seen still

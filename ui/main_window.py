@@ -62,6 +62,7 @@ from ui.controllers.point_sync import PointSyncController
 from ui.controllers.project_controller import ProjectController
 from ui.controllers.project_dialogs import ProjectDialogs
 from ui.controllers.safety_menu import SafetyParts, install_safety
+from ui.controllers.stop_timing import StopTiming
 from ui.controllers.word_order_watch import WordOrderWatch
 from ui.dialogs.confirm import ConfirmFn
 from ui.i18n import Translator
@@ -167,7 +168,7 @@ class MainWindow(QMainWindow):
             disconnect=self.link_guard.disconnect_link,
             reconnect=self.reconnect,
             can_reconnect=lambda: self.link_guard.last_connection() is not None,
-            stop=lambda: link.submit(Stop()),
+            stop=self._menu_stop,
             pause=lambda: link.submit(Pause()),
             resume=lambda: link.submit(Resume()),
             about=self.show_about,
@@ -196,6 +197,7 @@ class MainWindow(QMainWindow):
         self.safety_menu = install_safety(self._safety_parts())  # roles, envelope, audit (Safety menu)
         self.motion.safety = self.safety_menu.safety
         self.run_controller.audit = self.safety_menu.safety.session.audit  # a run's own pause (issue 19)
+        self.stop_timing.audit = self.safety_menu.safety.session.audit  # each stop measured
         self.cell = install_cell(self)  # File → Open cell…, the Cell tab (issue 23)
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*default_size())
@@ -240,6 +242,9 @@ class MainWindow(QMainWindow):
         self.motion = MotionController(
             link, self.control_bar, self.jog_panel, None, None, self.run_controller, self
         )
+        # measured stopping: an observer of the Stop, the jog release and the polls (issue 24)
+        self.stop_timing = StopTiming(state, self.control_bar, self.jog_panel, self)
+        self.stop_timing.measured.connect(self.monitor_panel.show_last_stop)
         # Step and Program are built on first use: gated the moment they exist, before shown
         self.step_tab.on_built(self.motion.add_step_panel)  # enabled or not at once, as the others
         self.program_tab.on_built(self.motion.add_program_panel)
@@ -267,7 +272,13 @@ class MainWindow(QMainWindow):
             planner_tab=self.planner_tab,
             view3d=self.view3d,
             refusal_line=self.control_column.refusal_line,
+            stopping=self.stop_timing.log.summary_lines,
         )
+
+    def _menu_stop(self) -> None:
+        """The menu's Stop (and Esc): to the link first; the measuring only watches."""
+        self.link.submit(Stop())
+        self.stop_timing.note_stop()
 
     @property
     def traffic_panel(self) -> TrafficPanel:  # built when its dock is first seen (WindowDocks)

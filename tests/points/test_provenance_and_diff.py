@@ -22,7 +22,9 @@ from app.points.provenance import UNKNOWN_PROVENANCE, Origin, edited, stamp
 SAMPLES = Path(__file__).resolve().parents[2] / "resources" / "samples"
 
 
-def _point(pid: int, x: float = 400.0, a: float = 180.0, b: float = 0.0, c: float = 0.0, tool: int = 200) -> TempPoint:
+def _point(
+    pid: int, x: float = 400.0, a: float = 180.0, b: float = 0.0, c: float = 0.0, tool: int = 200
+) -> TempPoint:
     return make_point(pid, f"p{pid}", (x, 0.0, 450.0, a, b, c), tool=tool)
 
 
@@ -30,9 +32,18 @@ def _point(pid: int, x: float = 400.0, a: float = 180.0, b: float = 0.0, c: floa
 
 
 def test_provenance_survives_save_and_load(tmp_path: Path) -> None:
-    taught = stamp(Origin.TAUGHT, controller="tcp 10.0.0.5:502 unit 1", software="TeachPad 9.9", when="2026-01-02T03:04:05Z")
-    typed = edited(stamp(Origin.TYPED, software="TeachPad 9.9", when="2026-01-01T00:00:00Z"), when="2026-01-03T00:00:00Z")
-    imported = stamp(Origin.IMPORTED, file="cell 3.csv", software="teachpad-cli 9.9", when="2026-01-04T00:00:00Z")
+    taught = stamp(
+        Origin.TAUGHT,
+        controller="tcp 10.0.0.5:502 unit 1",
+        software="TeachPad 9.9",
+        when="2026-01-02T03:04:05Z",
+    )
+    typed = edited(
+        stamp(Origin.TYPED, software="TeachPad 9.9", when="2026-01-01T00:00:00Z"), when="2026-01-03T00:00:00Z"
+    )
+    imported = stamp(
+        Origin.IMPORTED, file="cell 3.csv", software="teachpad-cli 9.9", when="2026-01-04T00:00:00Z"
+    )
     points = [
         with_provenance(_point(1), taught),
         with_provenance(_point(2), typed),
@@ -208,13 +219,17 @@ def test_cli_diff_finds_a_point_moved_02_mm_over_01(
     assert "1 difference over 0.1 mm / 0.1°" in out
 
 
-def test_cli_diff_of_a_005_mm_move_says_the_same(demo: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_diff_of_a_005_mm_move_says_the_same(
+    demo: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     other = _moved_copy(demo, tmp_path, 0.05)
     assert cli_main(["points", "diff", str(demo), str(other)]) == 0
     assert "the same within 0.1 mm / 0.1°" in capsys.readouterr().out
 
 
-def test_cli_diff_a_project_against_a_csv(demo: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]) -> None:
+def test_cli_diff_a_project_against_a_csv(
+    demo: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
     project = load_project(demo)
     points = list(project.ledger)[1:]  # the first one removed
     points.append(make_point(77, "new", (1.0, 2.0, 3.0, 0.0, 0.0, 0.0)))
@@ -229,7 +244,11 @@ def test_cli_diff_a_project_against_a_csv(demo: Path, tmp_path: Path, capsys: py
 @pytest.mark.parametrize(
     ("name", "content", "words"),
     [
-        ("bad.teachpad.json", '{"format": "teachpad-project", "version": 1, "points": [{"id": 1, "x": "abc"', "not valid JSON"),
+        (
+            "bad.teachpad.json",
+            '{"format": "teachpad-project", "version": 1, "points": [{"id": 1, "x": "abc"',
+            "not valid JSON",
+        ),
         ("bad.csv", "id,x,y,z,a,b,c\n1,abc,0,0,0,0,0\n", "'abc' is not a number"),
         ("gbk.csv", None, "not UTF-8"),
         ("missing.csv", "", "does not exist"),
