@@ -60,7 +60,7 @@ def register(psub: Any) -> None:
     """Add ``diff`` to the ``points`` command's actions (``app/cli/points.py`` calls it)."""
     p = psub.add_parser(
         "diff",
-        help="compare the points of two projects or CSV files: added, removed, moved (exit 1 when they differ)",
+        help="compare the points of two projects or CSV files: added, removed, moved (exit 1: they differ)",
     )
     p.add_argument("a", type=Path, metavar="A", help=_SOURCE_HELP)
     p.add_argument("b", type=Path, metavar="B", help=_SOURCE_HELP)

@@ -57,9 +57,9 @@ def merge_import(
 ) -> tuple[list[TempPoint], ImportReport]:
     """The list the ledger becomes when ``points`` are imported over ``current``, and the
     report. A point identical on the controller side to the one it replaces keeps that one's
-    sync state (and, when nothing at all changed, its provenance); others become ``CHANGED``. An empty list in replace mode raises
-    :class:`EmptyImport` unless ``allow_empty``. Fields are not checked here: the ledger's
-    ``replace_all`` checks the result."""
+    sync state (and, when nothing at all changed, its provenance); others become ``CHANGED``.
+    An empty list in replace mode raises :class:`EmptyImport` unless ``allow_empty``. Fields are
+    not checked here: the ledger's ``replace_all`` checks the result."""
     if not points and mode is ImportMode.REPLACE and not allow_empty:
         raise EmptyImport(len(current))
     old = {p.id: p for p in current}

@@ -27,7 +27,6 @@ from dataclasses import dataclass, field, replace
 
 from app.errors import InvalidInput, Reason
 from app.models import Pose
-from app.points.provenance import UNKNOWN_PROVENANCE, Provenance
 from app.points.fields import (
     DEFAULT_LIMITS,
     NAME_MAX_CHARS,
@@ -41,6 +40,7 @@ from app.points.fields import (
     parse_text,
     parse_tool,
 )
+from app.points.provenance import UNKNOWN_PROVENANCE, Provenance
 from app.protocol.enums import QT_TRANSLATE_NOOP
 from app.protocol.registers import TOOL_NONE
 

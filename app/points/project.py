@@ -72,13 +72,13 @@ from app.points.point import (
     point_from_fields,
     with_provenance,
 )
-from app.points.provenance import Origin, Provenance, provenance_from_json, software_name, stamp
 from app.points.project_model import HISTORY_TEXT_MAX, LastUpload, Project, now_iso
 from app.points.project_write import (
     FORMAT_NAME,
     FORMAT_VERSION,
     project_bytes,
 )
+from app.points.provenance import Origin, Provenance, provenance_from_json, software_name, stamp
 
 PROJECT_SUFFIX = ".teachpad.json"
 

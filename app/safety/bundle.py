@@ -7,7 +7,8 @@ secrets and tokens removed by key name and by value: see :func:`redact`), ``proj
 ``register-profile.json`` (word order, unit id, completion rule... in force), ``audit/`` (the
 audit files of the last ``days`` days), ``events.txt`` (the event log's lines),
 ``logs/`` (files of a log directory changed in the last ``days`` days), ``traffic.txt`` (recent
-Modbus traffic), ``stopping.txt`` (measured stopping of the session: :mod:`app.safety.stopping`), and ``manifest.json`` listing what is inside and what was left out, and why.
+Modbus traffic), ``stopping.txt`` (measured stopping of the session: :mod:`app.safety.stopping`),
+and ``manifest.json`` listing what is inside and what was left out, and why.
 
 The role store (password hashes) is never included, whatever is passed. Logs, events and traffic
 are redacted by value too (:func:`redact_text`); the audit files and the project go as they are
