@@ -68,6 +68,7 @@ from ui.dialogs.confirm import ConfirmFn
 from ui.i18n import Translator
 from ui.joins import labelled
 from ui.messages import error_text
+from ui.models.point_provenance import controller_text
 from ui.panels.monitor_panel import MonitorPanel
 from ui.panels.view3d_host import install_view3d
 from ui.settings import AppSettings
@@ -75,6 +76,7 @@ from ui.touch import apply_touch_mode, mark_motion
 from ui.window_actions import WindowActions
 from ui.window_cell import install_cell
 from ui.window_column import ControlColumn
+from ui.window_compare import install_compare
 from ui.window_docks import WindowDocks
 from ui.window_geometry import MIN_SIZE, default_size, restore_window
 from ui.window_rows import add_window_rows
@@ -120,6 +122,10 @@ class MainWindow(QMainWindow):
             dialogs=project_dialogs or ProjectDialogs(self), autosave_dir=autosave_dir, parent=self
         )
         self.point_sync = PointSyncController(self.project.points_model, link, self)
+        # points made here record the controller the link reaches (provenance, issue 24)
+        self.project.points_model.stamps.controller = lambda: controller_text(
+            link.state.connection.controller
+        )
         self.run_controller = PlanRunController(link, self, points=self.project.points_model)
 
         # --- left: control bar + motion tabs ----------------------------------------------
@@ -199,6 +205,7 @@ class MainWindow(QMainWindow):
         self.run_controller.audit = self.safety_menu.safety.session.audit  # a run's own pause (issue 19)
         self.stop_timing.audit = self.safety_menu.safety.session.audit  # each stop measured
         self.cell = install_cell(self)  # File → Open cell…, the Cell tab (issue 23)
+        self.compare = install_compare(self)  # File → Compare with… (issue 24)
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])
