@@ -604,6 +604,7 @@ class MainWindow(QMainWindow):
             app = QApplication.instance()
             if isinstance(app, QApplication):
                 app.applicationStateChanged.disconnect(self._on_application_state)
+        self.stop_timing.cancel()  # no measurement outlives the window
         if self.shutdown_link_on_close:
             self.link.shutdown()
         super().closeEvent(event)

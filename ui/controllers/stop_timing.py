@@ -2,7 +2,8 @@
 
 :class:`StopTiming` listens where the operator's intents are (the control bar's Stop, the
 menu's Stop and Esc through :meth:`StopTiming.note_stop`, the jog panel's release) and to
-every good poll (``RobotState.polled``, with the pose ``RobotState.pose`` holds then); it sends
+every good poll (``RobotState.polled``, with the pose ``RobotState.pose`` holds then), while the
+link is connected (a Stop without a link sends nothing: not measured); it sends
 nothing and changes nothing of the stop itself (the intents reach the link through
 :class:`~ui.controllers.motion.MotionController` as before). The measuring is
 :class:`app.safety.stopping.StopWatch`; each result goes to the session's
@@ -59,8 +60,15 @@ class StopTiming(QObject):
         self._start(StopKind.JOG_RELEASE)
 
     def _start(self, kind: StopKind) -> None:
+        if not self._state.connected:
+            return  # nothing was sent, nothing to see: not measured
         self.watch.click(kind, self._clock(), self._state.pose)
         self._timeout.start(int(self.watch.timeout * 1000) + 50)
+
+    def cancel(self) -> None:
+        """Give up the measurement under way (the window closes)."""
+        self._timeout.stop()
+        self.watch.cancel()
 
     @Slot(float)
     def _on_polled(self, when: float) -> None:

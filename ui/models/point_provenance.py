@@ -18,12 +18,6 @@ from app.points.provenance import Origin, Provenance, edited, software_name, sta
 
 __all__ = ["ProvenanceStamps", "controller_text", "provenance_tip", "when_text"]
 
-_CONTEXT = "PointProvenance"
-
-
-def _tr(text: str) -> str:
-    return QCoreApplication.translate(_CONTEXT, text)
-
 
 def when_text(iso: str) -> str:
     """``2026-11-29T12:00:00Z`` as ``2026-11-29 12:00:00 UTC`` (other text as it is)."""
@@ -36,20 +30,34 @@ def provenance_tip(made: Provenance) -> str:
     """A few lines: how the point was made, when, on which controller, with which software, the
     file it came from and its last edit."""
     if made.origin is Origin.UNKNOWN and not made.time:
-        return _tr("Made: unknown (saved before TeachPad recorded how points are made)")
+        return QCoreApplication.translate(
+            "PointProvenance", "Made: unknown (saved before TeachPad recorded how points are made)"
+        )
     how = QCoreApplication.translate(POINTS_CORE_CONTEXT, made.origin.text)
-    lines = [_tr("Made: {how}").format(how=how)]
+    lines = [QCoreApplication.translate("PointProvenance", "Made: {how}").format(how=how)]
     if made.file:
-        lines.append(_tr("File: {file}").format(file=made.file))
+        lines.append(QCoreApplication.translate("PointProvenance", "File: {file}").format(file=made.file))
     if made.time:
-        lines.append(_tr("When: {when}").format(when=when_text(made.time)))
-    lines.append(_tr("Controller: {controller}").format(controller=made.controller or _tr("none")))
-    if made.software:
-        lines.append(_tr("Software: {software}").format(software=made.software))
-    if made.edited:
-        where = made.edited_controller or _tr("no controller")
         lines.append(
-            _tr("Last edited: {when} ({controller})").format(when=when_text(made.edited), controller=where)
+            QCoreApplication.translate("PointProvenance", "When: {when}").format(when=when_text(made.time))
+        )
+    lines.append(
+        QCoreApplication.translate("PointProvenance", "Controller: {controller}").format(
+            controller=made.controller or QCoreApplication.translate("PointProvenance", "none")
+        )
+    )
+    if made.software:
+        lines.append(
+            QCoreApplication.translate("PointProvenance", "Software: {software}").format(
+                software=made.software
+            )
+        )
+    if made.edited:
+        where = made.edited_controller or QCoreApplication.translate("PointProvenance", "no controller")
+        lines.append(
+            QCoreApplication.translate("PointProvenance", "Last edited: {when} ({controller})").format(
+                when=when_text(made.edited), controller=where
+            )
         )
     return "\n".join(lines)
 

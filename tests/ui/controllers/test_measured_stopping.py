@@ -127,10 +127,19 @@ def test_a_stop_never_seen_still_says_so(
     qtbot: Any, sim: Any, window: Any, monkeypatch: pytest.MonkeyPatch
 ) -> None:
     monkeypatch.setattr(timing, "STOP_STILL_TIMEOUT", 0.3)
-    # not connected: no poll comes, the timeout ends the measurement
+    connect(qtbot, window.link, sim, poll_timeout=1.0)
+    sim.set_silent(True)  # no answer after the click: no poll shows the arm still
     t0 = time.monotonic()
     result = _measured(
         qtbot, window, lambda: qtbot.mouseClick(window.control_bar.stop_button, Qt.MouseButton.LeftButton)
     )
     assert not result.still and result.seconds == 0.3 and time.monotonic() - t0 >= 0.3
     assert window.monitor_panel.last_stop_label.text() == "Last stop: not seen still within 0.3 s (0.0 mm)"
+    sim.set_silent(False)
+
+
+def test_a_stop_without_a_link_is_not_measured(qtbot: Any, window: Any) -> None:
+    with qtbot.assertNotEmitted(window.stop_timing.measured, wait=100):
+        qtbot.mouseClick(window.control_bar.stop_button, Qt.MouseButton.LeftButton)
+    assert not window.stop_timing.watch.measuring
+    assert window.monitor_panel.last_stop_label.text() == "Last stop: not measured yet"
