@@ -42,7 +42,7 @@ DEFAULT_DAYS = 7
 _NO_EVENTS = "event log: none given"
 _NO_TRAFFIC = "Modbus traffic: none given (TeachPad records it; teachpad-cli takes a file with --traffic)"
 _TRAFFIC_EMPTY = "Modbus traffic: no frames recorded (no connection to a controller since TeachPad started)"
-_NO_STOPPING = "measured stopping: none given (TeachPad measures each Stop and jog release of its session)"
+_NO_STOPPING = "measured stopping: nothing measured in this session"
 MAX_FILE_BYTES = 64 * 1024 * 1024  # a single file larger than this is left out (and said so)
 _SECRET_WORDS = (
     r"pass(?:word|wd|phrase)?|pwd|hash|salt|secret|token|credential|api[_-]?key|private[_-]?key"
@@ -180,7 +180,8 @@ def build_support_bundle(
         _add_lines(w, "events.txt", events, _NO_EVENTS, f"event log: no events in the last {days} days")
         _add_logs(w, log_dir, (now - dt.timedelta(days=days)).timestamp())
         _add_lines(w, "traffic.txt", traffic, _NO_TRAFFIC, _TRAFFIC_EMPTY)
-        _add_lines(w, "stopping.txt", stopping, _NO_STOPPING, _NO_STOPPING)
+        if stopping is not None:  # the GUI's session (teachpad-cli has none to give)
+            _add_lines(w, "stopping.txt", stopping, _NO_STOPPING, _NO_STOPPING)
         manifest.files.append("manifest.json")
         zf.writestr("manifest.json", _manifest_json(manifest, days))
     return buf.getvalue(), manifest

@@ -9,8 +9,9 @@ when two consecutive polls agree within :data:`STILL_MM` (position and external 
 pair (the first time the arm was seen where it came to rest), so it is the controller's own
 stopping time plus at most one poll period. The pose known at the click counts as the poll
 before the first: an arm that was not moving measures 0 ms. The distance is the path the
-polls saw after the click (the sum of the straight steps between them, from the pose known at
-the click). No rest within :data:`app.timing.STOP_STILL_TIMEOUT` s: the measurement says so
+polls saw after the click: the sum of the straight steps between them, the first from where the
+arm was at the click (between the poll before the click and the one after it, as if it moved
+evenly: the pose known at the click is as old as its poll). No rest within :data:`app.timing.STOP_STILL_TIMEOUT` s: the measurement says so
 ("not seen still within 5 s") with the distance up to then.
 
 :class:`StopLog` keeps one session's measurements (the monitor's "last stop" line, the support
@@ -120,6 +121,7 @@ class StopWatch:
         self._kind = StopKind.STOP
         self._clicked: float | None = None
         self._start: Pose | None = None  # the pose known at the click
+        self._seen_at: float | None = None  # when that pose was polled
         self._prev: tuple[float, Pose] | None = None
         self._before: float | None = None  # the time of the sample before self._prev
         self._distance = 0.0
@@ -138,11 +140,13 @@ class StopWatch:
         """``time.monotonic()`` by which the arm must be seen still (None: not measuring)."""
         return None if self._clicked is None else self._clicked + self.timeout
 
-    def click(self, kind: StopKind, at: float, pose: Pose | None) -> None:
-        """The operator's Stop or jog release at ``at``; ``pose``: the last pose polled before it."""
+    def click(self, kind: StopKind, at: float, pose: Pose | None, seen_at: float | None = None) -> None:
+        """The operator's Stop or jog release at ``at``; ``pose``: the last pose polled before it,
+        at ``seen_at`` (None: not known; the distance then starts at ``pose`` itself)."""
         self._kind = kind
         self._clicked = at
         self._start = pose
+        self._seen_at = seen_at
         self._prev = None if pose is None else (at, pose)
         self._before = None
         self._distance = 0.0
@@ -163,13 +167,25 @@ class StopWatch:
             self._start = pose
         if prev is not None:
             moved, turned = _apart(prev[1], pose)
-            self._distance += math.dist((prev[1].x, prev[1].y, prev[1].z), (pose.x, pose.y, pose.z))
+            self._distance += math.dist(self._from(prev, at, pose), (pose.x, pose.y, pose.z))
             if moved <= self.still_mm and turned <= self.still_deg:
                 gap = prev[0] - (before if before is not None else clicked)
                 return self._finish(still=True, seconds=max(0.0, prev[0] - clicked), last=pose, gap=gap)
         if at - clicked >= self.timeout:
             return self._finish(still=False, seconds=self.timeout, last=pose)
         return None
+
+    def _from(self, prev: tuple[float, Pose], at: float, pose: Pose) -> tuple[float, float, float]:
+        """Where the step to the poll at ``at`` (``pose``) starts: the previous poll's position; for
+        the first poll after the click, the position at the click itself, between the poll before
+        it (at ``seen_at``) and this one, as if the arm moved evenly (the pose known at the click
+        is as old as that poll: counting from it would add what the arm did before the click)."""
+        p = prev[1]
+        seen, clicked = self._seen_at, self._clicked
+        if prev[0] != clicked or seen is None or clicked is None or not seen < clicked <= at:
+            return (p.x, p.y, p.z)
+        f = (clicked - seen) / (at - seen)
+        return (p.x + f * (pose.x - p.x), p.y + f * (pose.y - p.y), p.z + f * (pose.z - p.z))
 
     def expire(self, now: float) -> StopMeasurement | None:
         """The timeout passed without a poll showing rest (no polls at all: a lost link)."""

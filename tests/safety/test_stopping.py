@@ -33,6 +33,17 @@ def test_a_stop_is_timed_to_the_first_poll_of_the_still_pair() -> None:
     assert not watch.measuring
 
 
+def test_the_distance_starts_where_the_arm_was_at_the_click() -> None:
+    watch = StopWatch()
+    # polled at x = 100 at t = 9.99; the click at 10.00; the next poll (10.01) reads x = 102:
+    # the arm was at 101 at the click, not at the 100 of the last poll
+    watch.click(StopKind.STOP, 10.0, _pose(100.0), seen_at=9.99)
+    assert watch.sample(10.01, _pose(102.0)) is None
+    result = watch.sample(10.03, _pose(102.0))
+    assert result is not None and result.distance_mm == pytest.approx(1.0)
+    assert result.seconds == pytest.approx(0.01)
+
+
 def test_an_arm_not_moving_measures_zero() -> None:
     watch = StopWatch()
     watch.click(StopKind.JOG_RELEASE, 5.0, _pose(1.0))
@@ -95,5 +106,7 @@ def test_the_session_summary_and_the_bundle() -> None:
         text = zf.read("stopping.txt").decode("utf-8")
         assert json.loads(zf.read("manifest.json"))["files"].count("stopping.txt") == 1
     assert text.splitlines()[:2] == lines[:2]
-    _, manifest = build_support_bundle()
-    assert any(line.startswith("measured stopping: none given") for line in manifest.left_out)
+    _, manifest = build_support_bundle(stopping=[])
+    assert "measured stopping: nothing measured in this session" in manifest.left_out
+    data, _ = build_support_bundle()  # teachpad-cli's: no session, no file
+    assert "stopping.txt" not in zipfile.ZipFile(io.BytesIO(data)).namelist()

@@ -62,7 +62,9 @@ class StopTiming(QObject):
     def _start(self, kind: StopKind) -> None:
         if not self._state.connected:
             return  # nothing was sent, nothing to see: not measured
-        self.watch.click(kind, self._clock(), self._state.pose)
+        now = self._clock()
+        age = self._state.age(now)
+        self.watch.click(kind, now, self._state.pose, None if age is None else now - age)
         self._timeout.start(int(self.watch.timeout * 1000) + 50)
 
     def cancel(self) -> None:
