@@ -121,3 +121,6 @@ GATEWAY_HISTORY_LIMIT = 10_000
 
 # --- measured stopping (app/safety/stopping.py; issue 24) ----------------------------------------
 STOP_STILL_TIMEOUT = 5.0  # s after a Stop / jog release within which the arm must be seen still
+# s two polls alike must be apart to count as still: polls that come in a bunch (a late poller
+# catching up) can read one controller update twice while the arm still moves
+STOP_STILL_SPAN = 0.03

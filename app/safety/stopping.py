@@ -5,14 +5,17 @@ An observer, not part of the stop: :class:`StopWatch` is told the moment of the 
 click (``time.monotonic()``) and the pose known then, and is fed every good poll afterwards
 (its ``time.monotonic()`` and the pose it read); it never sends anything. The arm is **still**
 when two consecutive polls agree within :data:`STILL_MM` (position and external axes) and
-:data:`STILL_DEG` (orientation); the stop's time is from the click to the first poll of that
+:data:`STILL_DEG` (orientation) and are at least :data:`app.timing.STOP_STILL_SPAN` apart (a
+poll closer to the one before is passed over: polls in a bunch may read one controller update
+twice); the stop's time is from the click to the first poll of that
 pair (the first time the arm was seen where it came to rest), so it is the controller's own
 stopping time plus at most one poll period. The pose known at the click counts as the poll
 before the first: an arm that was not moving measures 0 ms. The distance is the path the
 polls saw after the click: the sum of the straight steps between them, the first from where the
 arm was at the click (between the poll before the click and the one after it, as if it moved
-evenly: the pose known at the click is as old as its poll). No rest within :data:`app.timing.STOP_STILL_TIMEOUT` s: the measurement says so
-("not seen still within 5 s") with the distance up to then.
+evenly: the pose known at the click is as old as its poll). No rest within
+:data:`app.timing.STOP_STILL_TIMEOUT` s: the measurement says so ("not seen still within 5 s")
+with the distance up to then.
 
 :class:`StopLog` keeps one session's measurements (the monitor's "last stop" line, the support
 bundle's summary). Qt-free: ``ui/controllers/stop_timing.py`` wires it to the Stop button, the
@@ -167,8 +170,12 @@ class StopWatch:
             self._start = pose
         if prev is not None:
             moved, turned = _apart(prev[1], pose)
-            self._distance += math.dist(self._from(prev, at, pose), (pose.x, pose.y, pose.z))
-            if moved <= self.still_mm and turned <= self.still_deg:
+            alike = moved <= self.still_mm and turned <= self.still_deg
+            if alike and at - prev[0] < timing.STOP_STILL_SPAN:
+                self._prev, self._before = prev, before  # too close to tell: wait for a later poll
+            else:
+                self._distance += math.dist(self._from(prev, at, pose), (pose.x, pose.y, pose.z))
+            if alike and at - prev[0] >= timing.STOP_STILL_SPAN:
                 gap = prev[0] - (before if before is not None else clicked)
                 return self._finish(still=True, seconds=max(0.0, prev[0] - clicked), last=pose, gap=gap)
         if at - clicked >= self.timeout:

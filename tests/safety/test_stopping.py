@@ -24,12 +24,13 @@ def test_a_stop_is_timed_to_the_first_poll_of_the_still_pair() -> None:
     assert watch.sample(10.02, _pose(102.0)) is None
     assert watch.sample(10.04, _pose(104.0)) is None
     assert watch.sample(10.06, _pose(105.0)) is None  # comes to rest here
-    result = watch.sample(10.08, _pose(105.0 + 0.005))  # within STILL_MM: still
+    assert watch.sample(10.08, _pose(105.0 + 0.005)) is None  # alike, but too close to tell
+    result = watch.sample(10.10, _pose(105.0 + 0.005))  # within STILL_MM, STOP_STILL_SPAN on: still
     assert result is not None and result.still
     assert result.seconds == pytest.approx(0.06)
     assert result.poll_gap == pytest.approx(0.02)
     assert result.distance_mm == pytest.approx(5.005)
-    assert result.text == "60 ms, 5.0 mm" and result.polls == 4
+    assert result.text == "60 ms, 5.0 mm" and result.polls == 5
     assert not watch.measuring
 
 
@@ -39,7 +40,7 @@ def test_the_distance_starts_where_the_arm_was_at_the_click() -> None:
     # the arm was at 101 at the click, not at the 100 of the last poll
     watch.click(StopKind.STOP, 10.0, _pose(100.0), seen_at=9.99)
     assert watch.sample(10.01, _pose(102.0)) is None
-    result = watch.sample(10.03, _pose(102.0))
+    result = watch.sample(10.05, _pose(102.0))
     assert result is not None and result.distance_mm == pytest.approx(1.0)
     assert result.seconds == pytest.approx(0.01)
 
@@ -47,7 +48,7 @@ def test_the_distance_starts_where_the_arm_was_at_the_click() -> None:
 def test_an_arm_not_moving_measures_zero() -> None:
     watch = StopWatch()
     watch.click(StopKind.JOG_RELEASE, 5.0, _pose(1.0))
-    result = watch.sample(5.02, _pose(1.0))
+    result = watch.sample(5.04, _pose(1.0))
     assert result is not None and result.seconds == 0.0 and result.distance_mm == 0.0
     assert result.kind is StopKind.JOG_RELEASE
 
@@ -55,19 +56,35 @@ def test_an_arm_not_moving_measures_zero() -> None:
 def test_an_external_axis_or_orientation_still_turning_is_not_still() -> None:
     watch = StopWatch()
     watch.click(StopKind.JOG_RELEASE, 0.0, _pose(1.0))
-    assert watch.sample(0.02, _pose(1.0, e1=0.5)) is None  # J7 moves, the TCP does not
-    assert watch.sample(0.04, _pose(1.0, e1=0.5, c=0.3)) is None  # turning
-    result = watch.sample(0.06, _pose(1.0, e1=0.5, c=0.3))
-    assert result is not None and result.seconds == pytest.approx(0.04)
+    assert watch.sample(0.04, _pose(1.0, e1=0.5)) is None  # J7 moves, the TCP does not
+    assert watch.sample(0.08, _pose(1.0, e1=0.5, c=0.3)) is None  # turning
+    result = watch.sample(0.12, _pose(1.0, e1=0.5, c=0.3))
+    assert result is not None and result.seconds == pytest.approx(0.08)
     assert result.rotation_deg == pytest.approx(0.3)
 
 
 def test_orientation_across_the_wrap_is_still() -> None:
     watch = StopWatch()
     watch.click(StopKind.STOP, 0.0, None)  # no pose known at the click: the first poll starts
-    assert watch.sample(0.02, Pose(0, 0, 0, 180.0, 0, 0)) is None
-    result = watch.sample(0.04, Pose(0, 0, 0, -180.0, 0, 0))  # the same orientation
-    assert result is not None and result.still and result.seconds == pytest.approx(0.02)
+    assert watch.sample(0.04, Pose(0, 0, 0, 180.0, 0, 0)) is None
+    result = watch.sample(0.08, Pose(0, 0, 0, -180.0, 0, 0))  # the same orientation
+    assert result is not None and result.still and result.seconds == pytest.approx(0.04)
+
+
+def test_polls_in_a_bunch_reading_one_update_twice_are_not_still() -> None:
+    watch = StopWatch()
+    watch.click(StopKind.STOP, 0.0, _pose(0.0))
+    assert watch.sample(0.050, _pose(5.0)) is None
+    assert watch.sample(0.052, _pose(5.0)) is None  # a late poller catching up: the same update
+    assert watch.sample(0.060, _pose(6.0)) is None  # the arm still moves
+    assert watch.sample(0.080, _pose(8.0)) is None
+    assert watch.sample(0.100, _pose(8.0)) is None
+    result = watch.sample(0.120, _pose(8.0))
+    assert (
+        result is not None
+        and result.seconds == pytest.approx(0.08)
+        and result.distance_mm == pytest.approx(8.0)
+    )
 
 
 def test_not_seen_still_within_the_timeout() -> None:
@@ -95,7 +112,7 @@ def test_the_session_summary_and_the_bundle() -> None:
         watch = StopWatch()
         watch.click(StopKind.STOP, at, _pose(0.0))
         watch.sample(at + 0.1, _pose(x))
-        result = watch.sample(at + 0.12, _pose(x))
+        result = watch.sample(at + 0.14, _pose(x))
         assert result is not None
         log.add(result)
     lines = log.summary_lines()

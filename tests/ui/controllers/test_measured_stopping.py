@@ -55,9 +55,11 @@ def _check_against_the_simulator(
     assert -POLL_PERIOD <= result.seconds - truth <= max(POLL_PERIOD, result.poll_gap) + 0.005
     # the distance: from where the arm was at the click (the simulator's pose then) to where it
     # rests; the product places the click between the polls around it, as if the arm moved evenly:
-    # off by at most the way the arm went between the last poll before the click and the click
+    # off by at most the way the arm went from the last poll before the click to its rest (the
+    # simulator moves in ticks: one more tick's way)
     travelled = math.dist(at_click["pose"][:3], rest.pose[:3])
-    assert result.distance_mm == pytest.approx(travelled, abs=speed * (at_click["age"] + 0.005) + 0.1)
+    window = at_click["age"] + max(0.0, truth) + 1.0 / timing.SIM_TICK_HZ
+    assert result.distance_mm == pytest.approx(travelled, abs=speed * window + 0.1)
 
 
 def test_a_stop_is_timed_as_the_simulator_recorded_it(
@@ -124,7 +126,9 @@ def test_a_jog_release_is_timed_the_same_way(qtbot: Any, sim: Any, window: Any) 
 def test_a_stop_never_seen_still_says_so(
     qtbot: Any, sim: Any, window: Any, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    monkeypatch.setattr(timing, "STOP_STILL_TIMEOUT", 0.3)
+    monkeypatch.setattr(timing, "STOP_STILL_TIMEOUT", 0.5)
+    # a loaded machine can hold the simulator's ticker a while: only a long pause counts as rest
+    monkeypatch.setattr(timing, "STOP_STILL_SPAN", 0.4)
     connect(qtbot, window.link, sim, poll_timeout=1.0)
     window.link.submit(Step(StepFrame.BASE, (0.0, 0.0, -100.0, 0.0, 0.0, 0.0), speed=50.0))  # 2 s
     qtbot.waitUntil(lambda: sim.state().moving, timeout=SIGNAL_TIMEOUT_MS)
@@ -132,9 +136,9 @@ def test_a_stop_never_seen_still_says_so(
     result = _measured(
         qtbot, window, lambda: qtbot.mouseClick(window.control_bar.stop_button, Qt.MouseButton.LeftButton)
     )
-    assert not result.still and result.seconds == 0.3 and result.distance_mm > 5.0
+    assert not result.still and result.seconds == 0.5 and result.distance_mm > 5.0
     label = window.monitor_panel.last_stop_label.text()
-    assert label == f"Last stop: not seen still within 0.3 s ({result.distance_mm:.1f} mm)"
+    assert label == f"Last stop: not seen still within 0.5 s ({result.distance_mm:.1f} mm)"
     monkeypatch.undo()
     window.link.submit(Stop())
     assert sim.wait_for(lambda s: not s.moving, 2.0)
