@@ -34,6 +34,7 @@ from app.points.diff import (
     PointsDiff,
     diff_points,
     load_points_source,
+    signed_mm,
 )
 from app.points.fields import PointLimits
 from app.points.point import TempPoint
@@ -122,7 +123,7 @@ def change_line(change: PointChange) -> str:
         dx, dy, dz = change.delta
         head += (
             f"  {change.distance_mm:.3f} mm  {change.rotation_deg:.2f}°"
-            f"  (dx {dx:+.3f} dy {dy:+.3f} dz {dz:+.3f})"
+            f"  (dx {signed_mm(dx)} dy {signed_mm(dy)} dz {signed_mm(dz)})"
         )
     if change.tool_changed:
         assert change.before is not None and change.after is not None

@@ -39,6 +39,7 @@ __all__ = [
     "is_csv",
     "load_points_source",
     "orientation_change_deg",
+    "signed_mm",
 ]
 
 DEFAULT_TOL_MM: Final = 0.1
@@ -160,6 +161,11 @@ def _compared(before: TempPoint, after: TempPoint, tol_mm: float, tol_deg: float
     if before.tool != after.tool:
         return PointChange(ChangeKind.TOOL, before, after, distance, rotation)
     return None
+
+
+def signed_mm(value: float) -> str:
+    """``+0.200`` / ``-0.050`` / ``+0.000`` (never ``-0.000``): a coordinate's change in mm."""
+    return f"{round(value, 3) or 0.0:+.3f}"
 
 
 def is_csv(path: str | os.PathLike[str]) -> bool:

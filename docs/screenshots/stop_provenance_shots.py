@@ -90,8 +90,9 @@ def main() -> None:
     link.connect_to(ConnectionSettings(host="127.0.0.1", port=sim.port, timeout=1.0))
     _wait(lambda: window.motion_enabled and link.state.status is not None)
     model = window.project.points_model
-    for dx in (0.0, 50.0):
+    for dx in (-50.0, 50.0):
         link.submit(Step(StepFrame.BASE, (dx, 0, 0, 0, 0, 0), speed=200.0))
+        _wait(lambda: sim.state().moving, 2.0)
         _wait(lambda: not sim.state().moving, 5.0)
         _spin(0.3)
         n = len(model.ledger)
@@ -131,10 +132,12 @@ def main() -> None:
         QToolTip.hideText()
         dialog = window.compare.compare_with(csv_path)
         assert dialog is not None
-        _spin(0.6)
+        _spin(0.3)
+        dialog.move(window.geometry().center() - dialog.rect().center())
+        _spin(0.3)
         _with(window, dialog).save(str(OUT / f"compare_{lang}_1280x800.png"))
         dialog.close()
-    window.close()
+    link.shutdown()  # no close: it would ask to save the untitled project
     sim.stop()
 
 

@@ -26,7 +26,15 @@ from PySide6.QtWidgets import (
     QWidget,
 )
 
-from app.points.diff import DEFAULT_TOL_DEG, DEFAULT_TOL_MM, ChangeKind, PointChange, PointsDiff, diff_points
+from app.points.diff import (
+    DEFAULT_TOL_DEG,
+    DEFAULT_TOL_MM,
+    ChangeKind,
+    PointChange,
+    PointsDiff,
+    diff_points,
+    signed_mm,
+)
 from app.points.point import TempPoint
 from ui.models.point_provenance import provenance_tip
 
@@ -150,7 +158,7 @@ class ComparePointsDialog(QDialog):
             change.point.label,
             f"{change.distance_mm:.3f}" if both else "",
             f"{change.rotation_deg:.2f}" if both else "",
-            f"{dx:+.3f}, {dy:+.3f}, {dz:+.3f}" if both else "",
+            ", ".join(map(signed_mm, (dx, dy, dz))) if both else "",
             tool,
         )
         tip = self._tip(change)
