@@ -12,6 +12,7 @@ A project written before provenance existed has no ``made`` key: its points read
 
 from __future__ import annotations
 
+import datetime as dt
 import enum
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
@@ -90,9 +91,8 @@ def software_name(program: str = "TeachPad") -> str:
 
 
 def _now() -> str:
-    from app.points.project_model import now_iso  # the project's own clock text
-
-    return now_iso()
+    """Now in UTC, as the project file writes times (``2026-11-29T12:00:00Z``)."""
+    return dt.datetime.now(dt.UTC).replace(microsecond=0).isoformat().replace("+00:00", "Z")
 
 
 def stamp(

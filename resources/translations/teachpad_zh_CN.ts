@@ -496,126 +496,136 @@
         </message>
         <message>
             <location filename="../../ui/audit_words.py" line="62" />
+            <source>stop measured</source>
+            <translation>停止已测量</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="63" />
+            <source>jog release measured</source>
+            <translation>点动松开已测量</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="64" />
             <source>reduced speed off</source>
             <translation>关闭降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="63" />
+            <location filename="../../ui/audit_words.py" line="65" />
             <source>clear the administrator password</source>
             <translation>清除管理员密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="68" />
+            <location filename="../../ui/audit_words.py" line="70" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="69" />
+            <location filename="../../ui/audit_words.py" line="71" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="70" />
+            <location filename="../../ui/audit_words.py" line="72" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="75" />
+            <location filename="../../ui/audit_words.py" line="77" />
             <source>log in as {role}</source>
             <translation>以{role}身份登录</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="76" />
+            <location filename="../../ui/audit_words.py" line="78" />
             <source>log out ({role})</source>
             <translation>注销（{role}）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="79" />
+            <location filename="../../ui/audit_words.py" line="81" />
             <source>set the {role} password</source>
             <translation>设置{role}密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="83" />
+            <location filename="../../ui/audit_words.py" line="85" />
             <source>change the {role} password</source>
             <translation>更改{role}密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="87" />
+            <location filename="../../ui/audit_words.py" line="89" />
             <source>clear the {role} password</source>
             <translation>清除{role}密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="91" />
+            <location filename="../../ui/audit_words.py" line="93" />
             <source>locked back to operator after {seconds} s idle</source>
             <translation>空闲 {seconds} s 后锁回操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="96" />
+            <location filename="../../ui/audit_words.py" line="98" />
             <source>{action} ({register})</source>
             <translation>{action}（{register}）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="98" />
+            <location filename="../../ui/audit_words.py" line="100" />
             <source>write {what}</source>
             <translation>写入 {what}</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="101" />
+            <location filename="../../ui/audit_words.py" line="103" />
             <source>sent; TeachPad stopped before the answer was recorded</source>
             <translation>已发送；记录应答之前 TeachPad 已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="102" />
+            <location filename="../../ui/audit_words.py" line="104" />
             <source>sent and answered; the controller's outcome was not recorded (still under way when read, or TeachPad stopped first)</source>
             <translation>已发送并已应答；未记录控制器的结果（读取时仍在进行，或 TeachPad 先停止了）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="232" />
+            <location filename="../../ui/audit_words.py" line="234" />
             <source>not sent: the controller is busy (program {state}); wait for it to end, or stop it</source>
             <translation>未发送：控制器忙（程序{state}）；请等它结束，或将其停止</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="239" />
+            <location filename="../../ui/audit_words.py" line="241" />
             <source>wrong password for the {role} role</source>
             <translation>{role}角色的密码错误</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="244" />
+            <location filename="../../ui/audit_words.py" line="246" />
             <source>no password is set for the {role} role; an administrator sets it</source>
             <translation>{role}角色尚未设置密码；由管理员设置</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="252" />
+            <location filename="../../ui/audit_words.py" line="254" />
             <source>the {role} role needs its password: run it in a terminal, or set {env}</source>
             <translation>{role}角色需要密码：请在终端中运行，或设置 {env}</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="260" />
+            <location filename="../../ui/audit_words.py" line="262" />
             <source>the administrator password is needed: run it in a terminal, or set {env}</source>
             <translation>需要管理员密码：请在终端中运行，或设置 {env}</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="267" />
+            <location filename="../../ui/audit_words.py" line="269" />
             <source>wrong administrator password</source>
             <translation>管理员密码错误</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="272" />
+            <location filename="../../ui/audit_words.py" line="274" />
             <source>the administrator password can be changed, not removed (anyone could then set it)</source>
             <translation>管理员密码只能修改，不能清除（否则任何人都可以重新设置它）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="285" />
+            <location filename="../../ui/audit_words.py" line="287" />
             <source>P{id} cannot be checked against the safety envelope: the host has no copy of it (give the project holding the point with {option})</source>
             <translation>P{id} 无法对照安全范围检查：主机没有它的副本（请用 {option} 给出含有该点的工程）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="312" />
+            <location filename="../../ui/audit_words.py" line="314" />
             <source>another Modbus master wrote to the controller less than {hold} s ago</source>
             <translation>另一个 Modbus 主站在不到 {hold} s 前写过控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="372" />
+            <location filename="../../ui/audit_words.py" line="374" />
             <source>needs the {need} role ({role} was logged in)</source>
             <translation>需要{need}角色（当时登录的是{role}）</translation>
         </message>
@@ -824,97 +834,97 @@ The pendant connects to it and commands it; every other robot of the cell stays 
     <context>
         <name>ComparePointsDialog</name>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="94" />
+            <location filename="../../ui/dialogs/compare_points.py" line="107" />
             <source>Compare points</source>
             <translation>比较点位</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="95" />
+            <location filename="../../ui/dialogs/compare_points.py" line="108" />
             <source>Distance tolerance (mm):</source>
             <translation>距离容差 (mm)：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="96" />
+            <location filename="../../ui/dialogs/compare_points.py" line="109" />
             <source>Angle tolerance (°):</source>
             <translation>角度容差 (°)：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="99" />
+            <location filename="../../ui/dialogs/compare_points.py" line="112" />
             <source>Change</source>
             <translation>变化</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="100" />
+            <location filename="../../ui/dialogs/compare_points.py" line="113" />
             <source>Point</source>
             <translation>点</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="101" />
+            <location filename="../../ui/dialogs/compare_points.py" line="114" />
             <source>Distance (mm)</source>
             <translation>距离 (mm)</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="102" />
+            <location filename="../../ui/dialogs/compare_points.py" line="115" />
             <source>Turn (°)</source>
             <translation>转角 (°)</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="103" />
+            <location filename="../../ui/dialogs/compare_points.py" line="116" />
             <source>dx, dy, dz (mm)</source>
             <translation>dx, dy, dz (mm)</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="104" />
+            <location filename="../../ui/dialogs/compare_points.py" line="117" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="117" />
+            <location filename="../../ui/dialogs/compare_points.py" line="130" />
             <source>A: {a} ({n} points)</source>
             <translation>A：{a}（{n} 个点）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="119" />
+            <location filename="../../ui/dialogs/compare_points.py" line="132" />
             <source>B: {b} ({n} points)</source>
             <translation>B：{b}（{n} 个点）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="123" />
+            <location filename="../../ui/dialogs/compare_points.py" line="136" />
             <source>{n} differences; {same} points the same</source>
             <translation>{n} 处不同；{same} 个点相同</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="126" />
+            <location filename="../../ui/dialogs/compare_points.py" line="139" />
             <source>The same within the tolerances ({n} points)</source>
             <translation>在容差范围内相同（{n} 个点）</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="133" />
+            <location filename="../../ui/dialogs/compare_points.py" line="146" />
             <source>added in B</source>
             <translation>B 中新增</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="134" />
+            <location filename="../../ui/dialogs/compare_points.py" line="147" />
             <source>removed in B</source>
             <translation>B 中删除</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="135" />
+            <location filename="../../ui/dialogs/compare_points.py" line="148" />
             <source>moved</source>
             <translation>已移动</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="136" />
+            <location filename="../../ui/dialogs/compare_points.py" line="149" />
             <source>other tool</source>
             <translation>工具不同</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="162" />
+            <location filename="../../ui/dialogs/compare_points.py" line="175" />
             <source>In A:</source>
             <translation>在 A 中：</translation>
         </message>
         <message>
-            <location filename="../../ui/dialogs/compare_points.py" line="164" />
+            <location filename="../../ui/dialogs/compare_points.py" line="177" />
             <source>In B:</source>
             <translation>在 B 中：</translation>
         </message>
@@ -4326,7 +4336,7 @@ The pendant connects to it and commands it; every other robot of the cell stays 
         <name>Points</name>
         <message>
             <location filename="../../app/points/point.py" line="181" />
-            <location filename="../../app/points/provenance.py" line="52" />
+            <location filename="../../app/points/provenance.py" line="53" />
             <source>unknown</source>
             <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host". Sent without an error, but the controller's status never changed (observe rule): most likely on the controller, not proven. Still needs an upload before a move relies on it.
 ----------
@@ -4354,17 +4364,17 @@ The longest text kept in one provenance field (a file name, a controller's endpo
             <translation>已在控制器上（未确认）</translation>
         </message>
         <message>
-            <location filename="../../app/points/provenance.py" line="53" />
+            <location filename="../../app/points/provenance.py" line="54" />
             <source>taught from the pose</source>
             <translation>从当前位姿示教</translation>
         </message>
         <message>
-            <location filename="../../app/points/provenance.py" line="54" />
+            <location filename="../../app/points/provenance.py" line="55" />
             <source>typed</source>
             <translation>手动输入</translation>
         </message>
         <message>
-            <location filename="../../app/points/provenance.py" line="55" />
+            <location filename="../../app/points/provenance.py" line="56" />
             <source>imported</source>
             <translation>导入</translation>
         </message>

@@ -158,7 +158,7 @@ class ComparePointsDialog(QDialog):
             change.point.label,
             f"{change.distance_mm:.3f}" if both else "",
             f"{change.rotation_deg:.2f}" if both else "",
-            ", ".join(map(signed_mm, (dx, dy, dz))) if both else "",
+            f"{signed_mm(dx)}, {signed_mm(dy)}, {signed_mm(dz)}" if both else "",  # numbers, not words
             tool,
         )
         tip = self._tip(change)
