@@ -10,7 +10,7 @@ summary line::
     removed  P3 'pick'
     moved    P5 'place'  0.200 mm  0.00°  (dx +0.200 dy +0.000 dz +0.000)
     tool     P7          tool 200 -> 3
-    4 differences over 0.1 mm / 0.1° (9 points the same)
+    4 differences over 0.1 mm / 0.1° (9 points are the same)
 
 Exit codes (the ``diff`` convention, within :class:`~app.cli.exit_codes.ExitCode`):
 0 (OK) the same within the tolerances, 1 (FAILED) they differ, 2 (USAGE) a file that cannot be
@@ -135,5 +135,6 @@ def summary_line(diff: PointsDiff) -> str:
     tolerances = f"{diff.tol_mm:g} mm / {diff.tol_deg:g}°"
     if not diff.differ:
         return f"the same within {tolerances} ({diff.same} points)"
-    n = len(diff.changes)
-    return f"{n} difference{'s' if n != 1 else ''} over {tolerances} ({diff.same} points the same)"
+    n, same = len(diff.changes), diff.same
+    points = "point is" if same == 1 else "points are"
+    return f"{n} difference{'s' if n != 1 else ''} over {tolerances} ({same} {points} the same)"

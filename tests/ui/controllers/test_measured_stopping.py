@@ -149,3 +149,14 @@ def test_a_stop_without_a_link_is_not_measured(qtbot: Any, window: Any) -> None:
         qtbot.mouseClick(window.control_bar.stop_button, Qt.MouseButton.LeftButton)
     assert not window.stop_timing.watch.measuring
     assert window.monitor_panel.last_stop_label.text() == "Last stop: not measured yet"
+
+
+def test_the_menus_stop_and_esc_are_measured_too(qtbot: Any, sim: Any, window: Any) -> None:
+    connect(qtbot, window.link, sim, poll_timeout=1.0)
+    qtbot.waitUntil(lambda: window.link.state.fresh, timeout=SIGNAL_TIMEOUT_MS)
+    result = _measured(qtbot, window, window.menus.stop_action.trigger)  # Esc's action
+    # nothing moved: still from the click on
+    assert (
+        result.kind is StopKind.STOP and result.still and result.seconds == 0.0 and result.distance_mm == 0.0
+    )
+    assert window.monitor_panel.last_stop_label.text() == "Last stop: 0 ms, 0.0 mm"
