@@ -122,3 +122,9 @@ GATEWAY_HISTORY_LIMIT = 10_000
 # a pendant stepping or moving to points between its commands still commands the robot
 GATEWAY_PLANT_PENDANT_WINDOW = 10.0
 GATEWAY_PLANT_COMMAND_TTL = 2.0  # s a DCMD may wait for its robot's poller; older: refused, never late
+
+# --- measured stopping (app/safety/stopping.py; issue 24) ----------------------------------------
+STOP_STILL_TIMEOUT = 5.0  # s after a Stop / jog release within which the arm must be seen still
+# s two polls alike must be apart to count as still: polls that come in a bunch (a late poller
+# catching up) can read one controller update twice while the arm still moves
+STOP_STILL_SPAN = 0.03

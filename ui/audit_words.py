@@ -59,6 +59,8 @@ _PHRASES = frozenset(
         QT_TRANSLATE_NOOP("AuditWords", "move to point"),
         QT_TRANSLATE_NOOP("AuditWords", "set the idle lock time"),
         QT_TRANSLATE_NOOP("AuditWords", "reduced speed on"),
+        QT_TRANSLATE_NOOP("AuditWords", "stop measured"),  # measured stopping (app/safety/stopping.py)
+        QT_TRANSLATE_NOOP("AuditWords", "jog release measured"),
         QT_TRANSLATE_NOOP("AuditWords", "reduced speed off"),
         QT_TRANSLATE_NOOP("AuditWords", "clear the administrator password"),
     }

@@ -63,11 +63,13 @@ from ui.controllers.project_controller import ProjectController
 from ui.controllers.project_dialogs import ProjectDialogs
 from ui.controllers.safety_menu import SafetyParts, install_safety
 from ui.controllers.selftest_watch import install_register_map_check
+from ui.controllers.stop_timing import StopTiming
 from ui.controllers.word_order_watch import WordOrderWatch
 from ui.dialogs.confirm import ConfirmFn
 from ui.i18n import Translator
 from ui.joins import labelled
 from ui.messages import error_text
+from ui.models.point_provenance import controller_text
 from ui.panels.monitor_panel import MonitorPanel
 from ui.panels.view3d_host import install_view3d
 from ui.settings import AppSettings
@@ -75,6 +77,7 @@ from ui.touch import apply_touch_mode, mark_motion
 from ui.window_actions import WindowActions
 from ui.window_cell import install_cell
 from ui.window_column import ControlColumn
+from ui.window_compare import install_compare
 from ui.window_docks import WindowDocks
 from ui.window_geometry import MIN_SIZE, default_size, restore_window
 from ui.window_rows import add_window_rows
@@ -121,6 +124,10 @@ class MainWindow(QMainWindow):
             dialogs=project_dialogs or ProjectDialogs(self), autosave_dir=autosave_dir, parent=self
         )
         self.point_sync = PointSyncController(self.project.points_model, link, self)
+        # points made here record the controller the link reaches (provenance, issue 24)
+        self.project.points_model.stamps.controller = lambda: controller_text(
+            link.state.connection.controller
+        )
         self.run_controller = PlanRunController(link, self, points=self.project.points_model)
 
         # --- left: control bar + motion tabs ----------------------------------------------
@@ -169,7 +176,7 @@ class MainWindow(QMainWindow):
             disconnect=self.link_guard.disconnect_link,
             reconnect=self.reconnect,
             can_reconnect=lambda: self.link_guard.last_connection() is not None,
-            stop=lambda: link.submit(Stop()),
+            stop=self._menu_stop,
             pause=lambda: link.submit(Pause()),
             resume=lambda: link.submit(Resume()),
             about=self.show_about,
@@ -198,9 +205,11 @@ class MainWindow(QMainWindow):
         self.safety_menu = install_safety(self._safety_parts())  # roles, envelope, audit (Safety menu)
         self.motion.safety = self.safety_menu.safety
         self.run_controller.audit = self.safety_menu.safety.session.audit  # a run's own pause (issue 19)
+        self.stop_timing.audit = self.safety_menu.safety.session.audit  # each stop measured
         self.cell = install_cell(self)  # File → Open cell…, the Cell tab (issue 23)
         self.register_map_check = install_register_map_check(self)  # Help → register map (issue 24)
         self.watch_list = install_watch_list(self)  # View → Watch list (issue 24)
+        self.compare = install_compare(self)  # File → Compare with… (issue 24)
         self.setMinimumSize(*MIN_SIZE)
         self.resize(*default_size())
         self.splitter.setSizes([360, max(600, self.width() - 360)])
@@ -244,6 +253,9 @@ class MainWindow(QMainWindow):
         self.motion = MotionController(
             link, self.control_bar, self.jog_panel, None, None, self.run_controller, self
         )
+        # measured stopping: an observer of the Stop, the jog release and the polls (issue 24)
+        self.stop_timing = StopTiming(state, self.control_bar, self.jog_panel, self)
+        self.stop_timing.measured.connect(self.monitor_panel.show_last_stop)
         # Step and Program are built on first use: gated the moment they exist, before shown
         self.step_tab.on_built(self.motion.add_step_panel)  # enabled or not at once, as the others
         self.program_tab.on_built(self.motion.add_program_panel)
@@ -271,7 +283,13 @@ class MainWindow(QMainWindow):
             planner_tab=self.planner_tab,
             view3d=self.view3d,
             refusal_line=self.control_column.refusal_line,
+            stopping=self.stop_timing.log.summary_lines,
         )
+
+    def _menu_stop(self) -> None:
+        """The menu's Stop (and Esc): to the link first; the measuring only watches."""
+        self.link.submit(Stop())
+        self.stop_timing.note_stop()
 
     @property
     def traffic_panel(self) -> TrafficPanel:  # built when its dock is first seen (WindowDocks)
@@ -590,6 +608,7 @@ class MainWindow(QMainWindow):
             app = QApplication.instance()
             if isinstance(app, QApplication):
                 app.applicationStateChanged.disconnect(self._on_application_state)
+        self.stop_timing.cancel()  # no measurement outlives the window
         if self.shutdown_link_on_close:
             self.link.shutdown()
         super().closeEvent(event)

@@ -33,6 +33,7 @@ EXAMPLES: dict[str, str] = {
     "points upload": "teachpad-cli --host 192.168.1.10 points upload cell.teachpad.json --ids 1,2,5-9",
     "points export": "teachpad-cli points export cell.teachpad.json --csv points.csv",
     "points import": "teachpad-cli points import cell.teachpad.json --csv points.csv --merge",
+    "points diff": "teachpad-cli points diff cell.teachpad.json points.csv --tol-mm 0.1 --tol-deg 0.1",
     "run": "teachpad-cli --host 192.168.1.10 run cell.teachpad.json --plan weld --from 3 --max-speed 250",
     "selftest": "teachpad-cli --host 192.168.1.10 --register-profile cell.registers.json selftest",
     "support-bundle": "teachpad-cli support-bundle support.zip --project cell.teachpad.json --days 3",

@@ -18,6 +18,7 @@ Commands::
     points upload PROJECT [--ids 1,2,5-9 | --needed]
     points export PROJECT --csv OUT [--no-bom]
     points import PROJECT --csv IN [--merge] [--allow-empty]   # creates PROJECT if missing
+    points diff   A B [--tol-mm 0.1] [--tol-deg 0.1]            # app/cli/points_diff.py
 
 Commands that write the project refuse while another TeachPad has it open
 (:mod:`app.points.lock`); ``points upload`` in monitor-only mode refuses before it reads the
@@ -37,6 +38,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from app import timing
+from app.cli import points_diff
 from app.cli.context import CliContext
 from app.cli.exit_codes import ExitCode, exit_code_for
 from app.cli.points_upload import BootWatch, open_boot, staged_upload
@@ -140,6 +142,8 @@ def register(subparsers: Any) -> None:
         help="let a CSV without rows replace (delete) all points of the project",
     )
     p.set_defaults(handler=cmd_points_import)
+
+    points_diff.register(psub)
 
 
 # --- helpers ------------------------------------------------------------------------------------

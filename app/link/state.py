@@ -19,6 +19,8 @@ field (property)       signal                      what
 ``stats``              ``statsChanged``            :class:`LinkStats` snapshot of the client
 ``halt``               ``haltChanged(object)``     :class:`UnconfirmedHalt`: a jog's stop or a
                                                    Stop the controller has not confirmed (None)
+(every good poll)      ``polled(float)``           its ``time.monotonic()``, after its pose (also
+                                                   when nothing changed: measured stopping)
 =====================  ==========================  ===========================================
 
 Freshness: ``fresh`` is True only while the link is CONNECTED and the last good poll is
@@ -70,6 +72,7 @@ class RobotState(QObject):
     rttChanged = Signal(float)  # noqa: N815
     statsChanged = Signal(LinkStats)  # noqa: N815
     haltChanged = Signal(object)  # noqa: N815 - UnconfirmedHalt | None
+    polled = Signal(float)  # every good poll's time.monotonic(), after its pose and status
 
     def __init__(
         self, parent: QObject | None = None, *, freshness_limit: float = DEFAULT_FRESHNESS_LIMIT
@@ -171,6 +174,7 @@ class RobotState(QObject):
     def note_good_poll(self, when: float) -> None:
         """A poll answered (``when``: its ``time.monotonic()``); emitted after its pose and status."""
         self._last_good = when
+        self.polled.emit(when)
         if self._connection.state is LinkState.CONNECTED:
             self._set_fresh(self._remaining() > 0)
         if self._fresh and not self._timer.isActive():

@@ -57,9 +57,9 @@ def merge_import(
 ) -> tuple[list[TempPoint], ImportReport]:
     """The list the ledger becomes when ``points`` are imported over ``current``, and the
     report. A point identical on the controller side to the one it replaces keeps that one's
-    sync state; others become ``CHANGED``. An empty list in replace mode raises
-    :class:`EmptyImport` unless ``allow_empty``. Fields are not checked here: the ledger's
-    ``replace_all`` checks the result."""
+    sync state (and, when nothing at all changed, its provenance); others become ``CHANGED``.
+    An empty list in replace mode raises :class:`EmptyImport` unless ``allow_empty``. Fields are
+    not checked here: the ledger's ``replace_all`` checks the result."""
     if not points and mode is ImportMode.REPLACE and not allow_empty:
         raise EmptyImport(len(current))
     old = {p.id: p for p in current}
@@ -80,11 +80,12 @@ def merge_import(
             added += 1
             incoming.append(replace(point, sync=SyncState.CHANGED, sync_error=""))
         elif previous.same_on_controller(point):
-            if previous.name == point.name and previous.note == point.note and previous.ext == point.ext:
-                unchanged += 1
-            else:
-                updated += 1
-            incoming.append(replace(point, sync=previous.sync, sync_error=previous.sync_error))
+            same = previous.name == point.name and previous.note == point.note and previous.ext == point.ext
+            unchanged += same
+            updated += not same
+            # an unchanged point keeps its history too (the import did not make it)
+            made = previous.made if same else point.made
+            incoming.append(replace(point, sync=previous.sync, sync_error=previous.sync_error, made=made))
         else:
             updated += 1
             incoming.append(replace(point, sync=SyncState.CHANGED, sync_error=""))

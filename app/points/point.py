@@ -23,7 +23,7 @@ import math
 import os
 import struct
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 
 from app.errors import InvalidInput, Reason
 from app.models import Pose
@@ -40,6 +40,7 @@ from app.points.fields import (
     parse_text,
     parse_tool,
 )
+from app.points.provenance import UNKNOWN_PROVENANCE, Provenance
 from app.protocol.enums import QT_TRANSLATE_NOOP
 from app.protocol.registers import TOOL_NONE
 
@@ -63,6 +64,7 @@ __all__ = [
     "point_from_fields",
     "point_from_pose",
     "with_field",
+    "with_provenance",
 ]
 
 TR_CONTEXT = "Points"
@@ -204,6 +206,8 @@ class TempPoint:
     note: str = ""
     sync: SyncState = SyncState.CHANGED
     sync_error: str = ""  # why the last upload failed (FAILED only)
+    #: how, when, where the point was made (history: not compared, the controller never holds it)
+    made: Provenance = field(default=UNKNOWN_PROVENANCE, compare=False)
 
     @property
     def xyzabc(self) -> Pose6:
@@ -353,6 +357,7 @@ def fast_point_from_fields(
             "note": note,
             "sync": sync,
             "sync_error": "",
+            "made": UNKNOWN_PROVENANCE,
         },
     )
     return point
@@ -360,6 +365,14 @@ def fast_point_from_fields(
 
 _new = object.__new__
 _set = object.__setattr__
+
+
+def with_provenance(point: TempPoint, made: Provenance) -> TempPoint:
+    """``point`` with its provenance set (copied the way :func:`fast_point_from_fields` builds a
+    point: a project load sets it on every point)."""
+    copy: TempPoint = _new(TempPoint)
+    _set(copy, "__dict__", {**point.__dict__, "made": made})
+    return copy
 
 
 def is_valid_point(point: TempPoint, limits: PointLimits = DEFAULT_LIMITS) -> bool:

@@ -64,13 +64,21 @@ from app.points.atomic import atomic_write_bytes, read_limited
 from app.points.csv_io import decode_text, parse_points_csv, points_to_csv
 from app.points.fields import DEFAULT_LIMITS, FieldError, OversizedNumber, PointLimits, has_surrogates, shown
 from app.points.ledger import PointLedger
-from app.points.point import FileFormatError, SyncState, TempPoint, fast_point_from_fields, point_from_fields
+from app.points.point import (
+    FileFormatError,
+    SyncState,
+    TempPoint,
+    fast_point_from_fields,
+    point_from_fields,
+    with_provenance,
+)
 from app.points.project_model import HISTORY_TEXT_MAX, LastUpload, Project, now_iso
 from app.points.project_write import (
     FORMAT_NAME,
     FORMAT_VERSION,
     project_bytes,
 )
+from app.points.provenance import Origin, Provenance, provenance_from_json, software_name, stamp
 from app.watchlist.project_io import KEY as WATCH_LIST_KEY
 from app.watchlist.project_io import watch_list_from
 
@@ -245,6 +253,9 @@ def _points_from(raw_points: list[Any], limits: PointLimits) -> tuple[list[TempP
         if point is None or point.id in seen:
             point = _careful_point(raw, i, limits, seen)
         seen[point.id] = i
+        made = raw.get("made")
+        if made is not None:
+            point = with_provenance(point, _provenance_from(made, i, point.id))
         points.append(point)
         uploaded = raw.get("uploaded")
         if uploaded is not None:
@@ -329,6 +340,11 @@ def _history_from(raw: object, index: int, point_id: int) -> LastUpload | None:
     when = _text_field(obj, "time", inner)
     endpoint = _text_field(obj, "endpoint", inner)
     return LastUpload(when[:HISTORY_TEXT_MAX], endpoint[:HISTORY_TEXT_MAX])
+
+
+def _provenance_from(raw: object, index: int, point_id: int) -> Provenance:
+    """A point's ``made`` object (how it was made); anything but an object is refused."""
+    return provenance_from_json(_expect(raw, dict, _point_place(index, point_id), "made", "object"))
 
 
 def _segment_from_dict(obj: Mapping[str, Any], where: Place) -> Segment:
@@ -425,9 +441,16 @@ def save_project(project: Project, path: str | os.PathLike[str], *, touch: bool 
 # --- CSV files ----------------------------------------------------------------------------------
 
 
-def read_points_csv(path: str | os.PathLike[str], limits: PointLimits = DEFAULT_LIMITS) -> list[TempPoint]:
+def read_points_csv(
+    path: str | os.PathLike[str], limits: PointLimits = DEFAULT_LIMITS, *, made: Provenance | None = None
+) -> list[TempPoint]:
+    """The file's points, each recording that it was imported from this file, now (``made``:
+    another provenance, e.g. with the controller the link reaches)."""
     p = Path(path)
-    return parse_points_csv(decode_text(read_limited(p), str(p)), limits, path=str(p))
+    points = parse_points_csv(decode_text(read_limited(p), str(p)), limits, path=str(p))
+    if made is None:
+        made = stamp(Origin.IMPORTED, software=software_name(), file=p.name)
+    return [with_provenance(point, made) for point in points]
 
 
 def write_points_csv(path: str | os.PathLike[str], points: Iterable[TempPoint], *, bom: bool = True) -> None:

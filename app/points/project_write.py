@@ -22,6 +22,7 @@ from app.plan.segments import Segment
 from app.points import atomic
 from app.points.point import EXT_FIELDS, POSE_FIELDS, TempPoint
 from app.points.project_model import LastUpload, Project
+from app.points.provenance import provenance_to_json
 from app.watchlist.entry import WatchEntry
 from app.watchlist.project_io import KEY as WATCH_LIST_KEY
 from app.watchlist.project_io import watch_list_to_json
@@ -35,6 +36,9 @@ def _point_to_dict(p: TempPoint, history: LastUpload | None = None) -> dict[str,
     d.update(zip(POSE_FIELDS, p.xyzabc, strict=True))
     d.update(zip(EXT_FIELDS, p.ext, strict=True))
     d.update({"tool": p.tool, "note": p.note})
+    made = provenance_to_json(p.made)
+    if made is not None:
+        d["made"] = made
     if history is not None:
         d["uploaded"] = {"time": history.time, "endpoint": history.endpoint}
     return d

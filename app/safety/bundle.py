@@ -7,7 +7,8 @@ secrets and tokens removed by key name and by value: see :func:`redact`), ``proj
 ``register-profile.json`` (word order, unit id, completion rule... in force), ``audit/`` (the
 audit files of the last ``days`` days), ``events.txt`` (the event log's lines),
 ``logs/`` (files of a log directory changed in the last ``days`` days), ``traffic.txt`` (recent
-Modbus traffic), and ``manifest.json`` listing what is inside and what was left out, and why.
+Modbus traffic), ``stopping.txt`` (measured stopping of the session: :mod:`app.safety.stopping`),
+and ``manifest.json`` listing what is inside and what was left out, and why.
 
 The role store (password hashes) is never included, whatever is passed. Logs, events and traffic
 are redacted by value too (:func:`redact_text`); the audit files and the project go as they are
@@ -41,6 +42,7 @@ DEFAULT_DAYS = 7
 _NO_EVENTS = "event log: none given"
 _NO_TRAFFIC = "Modbus traffic: none given (TeachPad records it; teachpad-cli takes a file with --traffic)"
 _TRAFFIC_EMPTY = "Modbus traffic: no frames recorded (no connection to a controller since TeachPad started)"
+_NO_STOPPING = "measured stopping: nothing measured in this session"
 MAX_FILE_BYTES = 64 * 1024 * 1024  # a single file larger than this is left out (and said so)
 _SECRET_WORDS = (
     r"pass(?:word|wd|phrase)?|pwd|hash|salt|secret|token|credential|api[_-]?key|private[_-]?key"
@@ -159,6 +161,7 @@ def build_support_bundle(
     events: Iterable[str] | None = None,
     log_dir: Path | None = None,
     traffic: Iterable[str] | None = None,
+    stopping: Iterable[str] | None = None,
     days: int = DEFAULT_DAYS,
     now: dt.datetime | None = None,
 ) -> tuple[bytes, BundleManifest]:
@@ -177,6 +180,8 @@ def build_support_bundle(
         _add_lines(w, "events.txt", events, _NO_EVENTS, f"event log: no events in the last {days} days")
         _add_logs(w, log_dir, (now - dt.timedelta(days=days)).timestamp())
         _add_lines(w, "traffic.txt", traffic, _NO_TRAFFIC, _TRAFFIC_EMPTY)
+        if stopping is not None:  # the GUI's session (teachpad-cli has none to give)
+            _add_lines(w, "stopping.txt", stopping, _NO_STOPPING, _NO_STOPPING)
         manifest.files.append("manifest.json")
         zf.writestr("manifest.json", _manifest_json(manifest, days))
     return buf.getvalue(), manifest

@@ -93,6 +93,18 @@ class SimEvent:
 
 
 @dataclass(frozen=True)
+class RestRecord:
+    """The arm came to rest (a move ended, a stop, a jog released): ``time.monotonic()`` and the
+    pose it rests at (``SimController.rest_records``)."""
+
+    t: float
+    pose: Pose6
+
+
+REST_LOG_LIMIT = 1000  # rest records kept (the oldest are dropped)
+
+
+@dataclass(frozen=True)
 class SimSnapshot:
     """A consistent copy of the controller's state (what a host could read, and more)."""
 

@@ -213,6 +213,12 @@ class SimRobot(ControllerCommands):
         return self.motion is not None or self.program is not None
 
     @property
+    def moving(self) -> bool:
+        """The arm moves now: a motion not paused, or a jog at a ratio above 0."""
+        running = self.motion is not None and not self.paused
+        return running or (self.teach_enabled and self.jogging and self.teach_ratio > 0)
+
+    @property
     def controller_mode(self) -> ControllerMode:
         if self.teach_enabled:
             return ControllerMode.MODBUS_TEACH

@@ -38,7 +38,7 @@ from app.protocol.registers import (
     gv_reg,
 )
 from app.sim.commands import StoredPoint
-from app.sim.config import SimConfig, SimEvent, SimSnapshot, WriteRecord
+from app.sim.config import REST_LOG_LIMIT, RestRecord, SimConfig, SimEvent, SimSnapshot, WriteRecord
 from app.sim.execute import CommandExecutor
 from app.sim.guard import CURRENT_CONNECTION, BadFrames, CommWatchdog
 from app.sim.motion import Pose6, TraceSample
@@ -114,6 +114,10 @@ class SimController:
         self.bad_frames = BadFrames()
         self.watchdog = CommWatchdog(self.config.watchdog, self._watchdog_stop)
         self._registers: list[int] | None = None  # the server's register block, once seen
+        # every time the arm came to rest (a move's end, a stop, a jog released), oldest first:
+        # the controller's own record of a stop, which measured stopping is checked against
+        self.rests: list[RestRecord] = []
+        self._was_moving = False
 
     # --- lifecycle ------------------------------------------------------------------------
     @property
@@ -239,6 +243,7 @@ class SimController:
                     except Exception:  # keep the simulator alive; the failure is in the log
                         log.exception("simulator tick failed")
                         self.robot.stop()
+                self._note_rest()
                 jogging = self.robot.jogging
             self.watchdog.check(jogging)
             self.bad_frames.flush()
@@ -284,9 +289,11 @@ class SimController:
                 log.info("write fc=0x%02X address=%d refused: exception %d", function_code, address, refused)
                 return refused
         with self.lock:
-            return self._carry_out(
+            answer = self._carry_out(
                 function_code, start_address, address, count, registers, values, connection
             )
+            self._note_rest()
+            return answer
 
     async def _injected_fault(
         self, serial: int, connection: int | None, address: int, count: int
@@ -460,6 +467,19 @@ class SimController:
             self.events.append(SimEvent(time.monotonic(), "watchdog", reason))
         log.warning("watchdog: jog stopped (ratio 0, teach still enabled): %s", reason)
         return True
+
+    def _note_rest(self) -> None:
+        """Under the lock, after anything that may start or end motion: note a rest."""
+        moving = self.robot.moving
+        if self._was_moving and not moving:
+            self.rests.append(RestRecord(time.monotonic(), self.robot.pose))
+            del self.rests[:-REST_LOG_LIMIT]
+        self._was_moving = moving
+
+    def rest_records(self) -> list[RestRecord]:
+        """When (``time.monotonic()``) and where the arm came to rest, oldest first."""
+        with self.lock:
+            return list(self.rests)
 
     def writes_to(self, address: int) -> list[WriteRecord]:
         """Writes that covered ``address``, narrowed to that one register: ``values == (v,)``."""

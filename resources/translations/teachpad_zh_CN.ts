@@ -506,126 +506,136 @@
         </message>
         <message>
             <location filename="../../ui/audit_words.py" line="62" />
+            <source>stop measured</source>
+            <translation>停止已测量</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="63" />
+            <source>jog release measured</source>
+            <translation>点动松开已测量</translation>
+        </message>
+        <message>
+            <location filename="../../ui/audit_words.py" line="64" />
             <source>reduced speed off</source>
             <translation>关闭降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="63" />
+            <location filename="../../ui/audit_words.py" line="65" />
             <source>clear the administrator password</source>
             <translation>清除管理员密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="68" />
+            <location filename="../../ui/audit_words.py" line="70" />
             <source>operator</source>
             <translation>操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="69" />
+            <location filename="../../ui/audit_words.py" line="71" />
             <source>engineer</source>
             <translation>工程师</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="70" />
+            <location filename="../../ui/audit_words.py" line="72" />
             <source>administrator</source>
             <translation>管理员</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="75" />
+            <location filename="../../ui/audit_words.py" line="77" />
             <source>log in as {role}</source>
             <translation>以{role}身份登录</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="76" />
+            <location filename="../../ui/audit_words.py" line="78" />
             <source>log out ({role})</source>
             <translation>注销（{role}）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="79" />
+            <location filename="../../ui/audit_words.py" line="81" />
             <source>set the {role} password</source>
             <translation>设置{role}密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="83" />
+            <location filename="../../ui/audit_words.py" line="85" />
             <source>change the {role} password</source>
             <translation>更改{role}密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="87" />
+            <location filename="../../ui/audit_words.py" line="89" />
             <source>clear the {role} password</source>
             <translation>清除{role}密码</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="91" />
+            <location filename="../../ui/audit_words.py" line="93" />
             <source>locked back to operator after {seconds} s idle</source>
             <translation>空闲 {seconds} s 后锁回操作员</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="96" />
+            <location filename="../../ui/audit_words.py" line="98" />
             <source>{action} ({register})</source>
             <translation>{action}（{register}）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="98" />
+            <location filename="../../ui/audit_words.py" line="100" />
             <source>write {what}</source>
             <translation>写入 {what}</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="101" />
+            <location filename="../../ui/audit_words.py" line="103" />
             <source>sent; TeachPad stopped before the answer was recorded</source>
             <translation>已发送；记录应答之前 TeachPad 已停止</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="102" />
+            <location filename="../../ui/audit_words.py" line="104" />
             <source>sent and answered; the controller's outcome was not recorded (still under way when read, or TeachPad stopped first)</source>
             <translation>已发送并已应答；未记录控制器的结果（读取时仍在进行，或 TeachPad 先停止了）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="232" />
+            <location filename="../../ui/audit_words.py" line="234" />
             <source>not sent: the controller is busy (program {state}); wait for it to end, or stop it</source>
             <translation>未发送：控制器忙（程序{state}）；请等它结束，或将其停止</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="239" />
+            <location filename="../../ui/audit_words.py" line="241" />
             <source>wrong password for the {role} role</source>
             <translation>{role}角色的密码错误</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="244" />
+            <location filename="../../ui/audit_words.py" line="246" />
             <source>no password is set for the {role} role; an administrator sets it</source>
             <translation>{role}角色尚未设置密码；由管理员设置</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="252" />
+            <location filename="../../ui/audit_words.py" line="254" />
             <source>the {role} role needs its password: run it in a terminal, or set {env}</source>
             <translation>{role}角色需要密码：请在终端中运行，或设置 {env}</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="260" />
+            <location filename="../../ui/audit_words.py" line="262" />
             <source>the administrator password is needed: run it in a terminal, or set {env}</source>
             <translation>需要管理员密码：请在终端中运行，或设置 {env}</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="267" />
+            <location filename="../../ui/audit_words.py" line="269" />
             <source>wrong administrator password</source>
             <translation>管理员密码错误</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="272" />
+            <location filename="../../ui/audit_words.py" line="274" />
             <source>the administrator password can be changed, not removed (anyone could then set it)</source>
             <translation>管理员密码只能修改，不能清除（否则任何人都可以重新设置它）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="285" />
+            <location filename="../../ui/audit_words.py" line="287" />
             <source>P{id} cannot be checked against the safety envelope: the host has no copy of it (give the project holding the point with {option})</source>
             <translation>P{id} 无法对照安全范围检查：主机没有它的副本（请用 {option} 给出含有该点的工程）</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="312" />
+            <location filename="../../ui/audit_words.py" line="314" />
             <source>another Modbus master wrote to the controller less than {hold} s ago</source>
             <translation>另一个 Modbus 主站在不到 {hold} s 前写过控制器</translation>
         </message>
         <message>
-            <location filename="../../ui/audit_words.py" line="372" />
+            <location filename="../../ui/audit_words.py" line="374" />
             <source>needs the {need} role ({role} was logged in)</source>
             <translation>需要{need}角色（当时登录的是{role}）</translation>
         </message>
@@ -901,6 +911,133 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <location filename="../../ui/panels/cell_panel.py" line="350" />
             <source>History</source>
             <translation>历史</translation>
+        </message>
+    </context>
+    <context>
+        <name>ComparePoints</name>
+        <message>
+            <location filename="../../ui/window_compare.py" line="48" />
+            <source>Compare &amp;with…</source>
+            <translation>比较(&amp;W)…</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_compare.py" line="51" />
+            <source>Compare the project's points with another project or a points CSV: added, removed, moved</source>
+            <translation>将本项目的点与另一个项目或点位 CSV 比较：新增、删除、移动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_compare.py" line="64" />
+            <source>Compare with</source>
+            <translation>比较对象</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_compare.py" line="64" />
+            <source>Projects and points CSV (*.json *.csv);;All files (*)</source>
+            <translation>项目和点位 CSV (*.json *.csv);;所有文件 (*)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/window_compare.py" line="75" />
+            <location filename="../../ui/window_compare.py" line="78" />
+            <source>Cannot compare</source>
+            <translation>无法比较</translation>
+        </message>
+    </context>
+    <context>
+        <name>ComparePointsDialog</name>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="107" />
+            <source>Compare points</source>
+            <translation>比较点位</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="108" />
+            <source>Distance tolerance (mm):</source>
+            <translation>距离容差 (mm)：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="109" />
+            <source>Angle tolerance (°):</source>
+            <translation>角度容差 (°)：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="112" />
+            <source>Change</source>
+            <translation>变化</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="113" />
+            <source>Point</source>
+            <translation>点</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="114" />
+            <source>Distance (mm)</source>
+            <translation>距离 (mm)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="115" />
+            <source>Turn (°)</source>
+            <translation>转角 (°)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="116" />
+            <source>dx, dy, dz (mm)</source>
+            <translation>dx, dy, dz (mm)</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="117" />
+            <source>Tool</source>
+            <translation>工具</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="130" />
+            <source>A: {a} ({n} points)</source>
+            <translation>A：{a}（{n} 个点）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="132" />
+            <source>B: {b} ({n} points)</source>
+            <translation>B：{b}（{n} 个点）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="136" />
+            <source>{n} differences; {same} points the same</source>
+            <translation>{n} 处不同；{same} 个点相同</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="139" />
+            <source>The same within the tolerances ({n} points)</source>
+            <translation>在容差范围内相同（{n} 个点）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="146" />
+            <source>added in B</source>
+            <translation>B 中新增</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="147" />
+            <source>removed in B</source>
+            <translation>B 中删除</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="148" />
+            <source>moved</source>
+            <translation>已移动</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="149" />
+            <source>other tool</source>
+            <translation>工具不同</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="175" />
+            <source>In A:</source>
+            <translation>在 A 中：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/dialogs/compare_points.py" line="177" />
+            <source>In B:</source>
+            <translation>在 B 中：</translation>
         </message>
     </context>
     <context>
@@ -1775,7 +1912,7 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>仅监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="358" />
+            <location filename="../../ui/main_window.py" line="376" />
             <source>TeachPad</source>
             <translation>TeachPad 示教器</translation>
         </message>
@@ -1806,7 +1943,7 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>往返 —</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="404" />
+            <location filename="../../ui/main_window.py" line="422" />
             <source>The controller restarted (its temp points are gone): restore them from the Points tab</source>
             <translation>控制器已重启（临时点已丢失）：请在“点位”页恢复全部点</translation>
         </message>
@@ -1851,30 +1988,30 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>迹象：{sign}。另一个主站与 TeachPad 共用参数和指令寄存器：它的写入可能改变我们指令的效果。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="427" />
+            <location filename="../../ui/main_window.py" line="445" />
             <source>Reconnected to the controller: jog stopped and teach mode switched off</source>
             <translation>已重新连接控制器：点动已停止，示教模式已关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="382" />
-            <location filename="../../ui/main_window.py" line="406" />
-            <location filename="../../ui/main_window.py" line="415" />
-            <location filename="../../ui/main_window.py" line="428" />
+            <location filename="../../ui/main_window.py" line="400" />
+            <location filename="../../ui/main_window.py" line="424" />
+            <location filename="../../ui/main_window.py" line="433" />
+            <location filename="../../ui/main_window.py" line="446" />
             <source>link</source>
             <translation>通信</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="335" />
+            <location filename="../../ui/main_window.py" line="353" />
             <source>Monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="336" />
+            <location filename="../../ui/main_window.py" line="354" />
             <source>Points</source>
             <translation>点位</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="337" />
+            <location filename="../../ui/main_window.py" line="355" />
             <source>Planner</source>
             <translation>轨迹规划</translation>
         </message>
@@ -1884,37 +2021,37 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>报警</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="422" />
+            <location filename="../../ui/main_window.py" line="440" />
             <source>plan run</source>
             <translation>计划运行</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="502" />
+            <location filename="../../ui/main_window.py" line="520" />
             <source>About TeachPad</source>
             <translation>关于 TeachPad</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="504" />
+            <location filename="../../ui/main_window.py" line="522" />
             <source>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;Desktop teach pendant for Bochuang robot controllers (Modbus TCP / RTU).&lt;br&gt;&lt;br&gt;Esc stops all motion. Jog buttons and keys move only while held.</source>
             <translation>&lt;b&gt;TeachPad {version}&lt;/b&gt;&lt;br&gt;博创机器人控制器桌面示教器（Modbus TCP / RTU）。&lt;br&gt;&lt;br&gt;按 Esc 停止所有运动。点动按钮和按键仅在按住时运动。</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="517" />
+            <location filename="../../ui/main_window.py" line="535" />
             <source>Safety state (roles, envelope, audit trail), machine-wide: {folder}</source>
             <translation>安全状态（角色、安全范围、审计记录），本机共用：{folder}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="519" />
+            <location filename="../../ui/main_window.py" line="537" />
             <source>Safety state (roles, envelope), this user's: {folder}&lt;br&gt;Audit trail: {audit}</source>
             <translation>安全状态（角色、安全范围），当前用户：{folder}&lt;br&gt;审计记录：{audit}</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="538" />
+            <location filename="../../ui/main_window.py" line="556" />
             <source>language</source>
             <translation>语言</translation>
         </message>
         <message>
-            <location filename="../../ui/main_window.py" line="538" />
+            <location filename="../../ui/main_window.py" line="556" />
             <source>No translation file for {code}</source>
             <translation>没有 {code} 的翻译文件</translation>
         </message>
@@ -3303,105 +3440,135 @@ The pendant connects to it and commands it; every other robot of the cell stays 
     <context>
         <name>MonitorPanel</name>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="191" />
-            <location filename="../../ui/panels/monitor_panel.py" line="210" />
+            <location filename="../../ui/panels/monitor_panel.py" line="201" />
+            <location filename="../../ui/panels/monitor_panel.py" line="221" />
             <source>mm</source>
             <extracomment>Attributes that exist once the plots are built (asking for one builds them).</extracomment>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="191" />
-            <location filename="../../ui/panels/monitor_panel.py" line="210" />
+            <location filename="../../ui/panels/monitor_panel.py" line="201" />
+            <location filename="../../ui/panels/monitor_panel.py" line="221" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="192" />
+            <location filename="../../ui/panels/monitor_panel.py" line="202" />
             <source>TCP position (base frame)</source>
             <translation>TCP 位置（基坐标系）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="194" />
+            <location filename="../../ui/panels/monitor_panel.py" line="204" />
             <source>Joints and external axes (°)</source>
             <translation>关节与附加轴（°）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="198" />
+            <location filename="../../ui/panels/monitor_panel.py" line="208" />
             <source>{n} s</source>
             <translation>{n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="199" />
+            <location filename="../../ui/panels/monitor_panel.py" line="209" />
             <source>Time span of the position plots</source>
             <translation>位置曲线的时间范围</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="200" />
+            <location filename="../../ui/panels/monitor_panel.py" line="210" />
             <source>Window:</source>
             <translation>时间窗：</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="201" />
+            <location filename="../../ui/panels/monitor_panel.py" line="211" />
             <source>Pause plots</source>
             <translation>暂停曲线</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="202" />
+            <location filename="../../ui/panels/monitor_panel.py" line="212" />
             <source>Freeze the plots; samples keep being recorded</source>
             <translation>冻结曲线；采样继续记录</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="203" />
+            <location filename="../../ui/panels/monitor_panel.py" line="213" />
             <source>Clear trace</source>
             <translation>清除轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="204" />
+            <location filename="../../ui/panels/monitor_panel.py" line="214" />
             <source>Erase the X–Y path trace</source>
             <translation>清除 X–Y 平面轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="211" />
+            <location filename="../../ui/panels/monitor_panel.py" line="222" />
             <source>position</source>
             <translation>位置</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="212" />
+            <location filename="../../ui/panels/monitor_panel.py" line="223" />
             <source>orientation</source>
             <translation>姿态</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="213" />
+            <location filename="../../ui/panels/monitor_panel.py" line="224" />
             <source>time</source>
             <translation>时间</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="213" />
+            <location filename="../../ui/panels/monitor_panel.py" line="224" />
             <source>s</source>
             <translation>s</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="214" />
+            <location filename="../../ui/panels/monitor_panel.py" line="225" />
             <source>Top view (X–Y)</source>
             <translation>俯视图（X–Y）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="233" />
+            <location filename="../../ui/panels/monitor_panel.py" line="244" />
             <source>Stale: not confirmed by the controller within the freshness limit</source>
             <translation>数据过期：未在时效内得到控制器确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="432" />
+            <location filename="../../ui/panels/monitor_panel.py" line="443" />
             <source>values stale (grey): no fresh data from the controller</source>
             <translation>数值已过期（灰色）：控制器无新数据</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="428" />
+            <location filename="../../ui/panels/monitor_panel.py" line="456" />
+            <source>Last stop: not measured yet</source>
+            <translation>上次停止：尚未测量</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/monitor_panel.py" line="458" />
+            <source>Last stop:</source>
+            <translation>上次停止：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/monitor_panel.py" line="458" />
+            <source>Last jog release:</source>
+            <translation>上次点动松开：</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/monitor_panel.py" line="460" />
+            <source>{ms} ms, {mm} mm</source>
+            <translation>{ms} ms，{mm} mm</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/monitor_panel.py" line="462" />
+            <source>not seen still within {s} s ({mm} mm)</source>
+            <translation>{s} 秒内未见静止（{mm} mm）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/monitor_panel.py" line="469" />
+            <source>Measured stopping: from the click on Stop (or a jog's release) to the arm seen still (two polls alike), and the distance it travelled meanwhile. {n} measured in this session.</source>
+            <translation>停止测量：从点击停止（或松开点动）到看到机械臂静止（两次轮询相同）的时间，以及其间移动的距离。本次会话已测量 {n} 次。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/monitor_panel.py" line="439" />
             <source>Plots: last {n} s</source>
             <translation>曲线：最近 {n} 秒</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/monitor_panel.py" line="430" />
+            <location filename="../../ui/panels/monitor_panel.py" line="441" />
             <source>paused</source>
             <translation>已暂停</translation>
         </message>
@@ -4185,6 +4352,54 @@ The pendant connects to it and commands it; every other robot of the cell stays 
         </message>
     </context>
     <context>
+        <name>PointProvenance</name>
+        <message>
+            <location filename="../../ui/models/point_provenance.py" line="33" />
+            <source>Made: unknown (saved before TeachPad recorded how points are made)</source>
+            <translation>来源：未知（保存于 TeachPad 记录点位来源之前）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/point_provenance.py" line="37" />
+            <source>Made: {how}</source>
+            <translation>来源：{how}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/point_provenance.py" line="39" />
+            <source>File: {file}</source>
+            <translation>文件：{file}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/point_provenance.py" line="42" />
+            <source>When: {when}</source>
+            <translation>时间：{when}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/point_provenance.py" line="45" />
+            <source>Controller: {controller}</source>
+            <translation>控制器：{controller}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/point_provenance.py" line="46" />
+            <source>none</source>
+            <translation>无</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/point_provenance.py" line="51" />
+            <source>Software: {software}</source>
+            <translation>软件：{software}</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/point_provenance.py" line="56" />
+            <source>no controller</source>
+            <translation>无控制器</translation>
+        </message>
+        <message>
+            <location filename="../../ui/models/point_provenance.py" line="58" />
+            <source>Last edited: {when} ({controller})</source>
+            <translation>最后编辑：{when}（{controller}）</translation>
+        </message>
+    </context>
+    <context>
         <name>PointSyncController</name>
         <message>
             <location filename="../../ui/controllers/point_sync.py" line="172" />
@@ -4347,30 +4562,48 @@ The pendant connects to it and commands it; every other robot of the cell stays 
     <context>
         <name>Points</name>
         <message>
-            <location filename="../../app/points/point.py" line="179" />
+            <location filename="../../app/points/point.py" line="181" />
+            <location filename="../../app/points/provenance.py" line="53" />
             <source>unknown</source>
-            <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host". Sent without an error, but the controller's status never changed (observe rule): most likely on the controller, not proven. Still needs an upload before a move relies on it.</extracomment>
+            <extracomment>The editable fields of a point, in table / CSV column order. Fields the controller stores: editing one of them makes the point "changed on host". Sent without an error, but the controller's status never changed (observe rule): most likely on the controller, not proven. Still needs an upload before a move relies on it.
+----------
+The longest text kept in one provenance field (a file name, a controller's endpoint).</extracomment>
             <translation>未知</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="180" />
+            <location filename="../../app/points/point.py" line="182" />
             <source>on controller</source>
             <translation>已在控制器上</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="181" />
+            <location filename="../../app/points/point.py" line="183" />
             <source>changed on host</source>
             <translation>上位机已修改</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="182" />
+            <location filename="../../app/points/point.py" line="184" />
             <source>upload failed</source>
             <translation>上传失败</translation>
         </message>
         <message>
-            <location filename="../../app/points/point.py" line="183" />
+            <location filename="../../app/points/point.py" line="185" />
             <source>on controller, unconfirmed</source>
             <translation>已在控制器上（未确认）</translation>
+        </message>
+        <message>
+            <location filename="../../app/points/provenance.py" line="54" />
+            <source>taught from the pose</source>
+            <translation>从当前位姿示教</translation>
+        </message>
+        <message>
+            <location filename="../../app/points/provenance.py" line="55" />
+            <source>typed</source>
+            <translation>手动输入</translation>
+        </message>
+        <message>
+            <location filename="../../app/points/provenance.py" line="56" />
+            <source>imported</source>
+            <translation>导入</translation>
         </message>
     </context>
     <context>
@@ -4389,147 +4622,148 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>工具 {n}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="127" />
+            <location filename="../../ui/models/points_model.py" line="131" />
             <source>ID</source>
+            <extracomment>how the points made here are stamped (the window tells it the controller the link reaches)</extracomment>
             <translation>编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="128" />
+            <location filename="../../ui/models/points_model.py" line="132" />
             <source>Name</source>
             <translation>名称</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="129" />
+            <location filename="../../ui/models/points_model.py" line="133" />
             <source>Tool</source>
             <translation>工具</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="130" />
+            <location filename="../../ui/models/points_model.py" line="134" />
             <source>Sync</source>
             <translation>同步状态</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="131" />
+            <location filename="../../ui/models/points_model.py" line="135" />
             <source>Note</source>
             <translation>备注</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="138" />
+            <location filename="../../ui/models/points_model.py" line="142" />
             <source>Temp point id on the controller</source>
             <translation>控制器上的临时点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="139" />
+            <location filename="../../ui/models/points_model.py" line="143" />
             <source>Tool frame (200 = none)</source>
             <translation>工具坐标系（200 = 无）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="140" />
+            <location filename="../../ui/models/points_model.py" line="144" />
             <source>Whether the controller holds this point</source>
             <translation>控制器上是否有此点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="141" />
+            <location filename="../../ui/models/points_model.py" line="145" />
             <source>mm, base frame</source>
             <translation>毫米，基坐标系</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="142" />
+            <location filename="../../ui/models/points_model.py" line="146" />
             <source>degrees</source>
             <translation>度</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="145" />
+            <location filename="../../ui/models/points_model.py" line="149" />
             <source>External axis (recorded only: the controller does not store it); CSV column {column}</source>
             <translation>外部轴（仅记录：控制器不保存）；CSV 列 {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="213" />
+            <location filename="../../ui/models/points_model.py" line="217" />
             <source>no reason given</source>
             <translation>未给出原因</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="214" />
+            <location filename="../../ui/models/points_model.py" line="218" />
             <source>Upload failed: {reason}</source>
             <translation>上传失败：{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="217" />
+            <location filename="../../ui/models/points_model.py" line="221" />
             <source>Not known whether the controller holds this point (it restarted, it is another controller, or the arm did not arrive there): a move to it creates it again first</source>
             <translation>不知道控制器是否保存着此点（控制器已重启、是另一台控制器，或机械臂未到达该点）：移动到此点时会先重新创建它</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="221" />
+            <location filename="../../ui/models/points_model.py" line="225" />
             <source>The controller holds this point with these values</source>
             <translation>控制器上的此点与这些数值一致</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="222" />
+            <location filename="../../ui/models/points_model.py" line="226" />
             <source>Changed on the host (or new) since the last upload</source>
             <translation>自上次上传后已在上位机修改（或为新点）</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="224" />
+            <location filename="../../ui/models/points_model.py" line="228" />
             <source>Sent without an error, but the controller's status never changed: most likely there, not proven; upload it again before moving to it</source>
             <translation>发送无错误，但控制器状态一直未变：很可能已在控制器上，但未经证实；移动到该点前请重新上传</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="232" />
+            <location filename="../../ui/models/points_model.py" line="236" />
             <source>Tool frame {value}</source>
             <translation>工具坐标系 {value}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="279" />
+            <location filename="../../ui/models/points_model.py" line="283" />
             <source>{point}, {column}: refused, {reason}</source>
             <translation>{point}，{column}：输入被拒绝，{reason}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="308" />
+            <location filename="../../ui/models/points_model.py" line="313" />
             <source>Edit {point} {column}</source>
             <translation>编辑 {point} {column}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="325" />
+            <location filename="../../ui/models/points_model.py" line="331" />
             <source>Add {point}</source>
             <translation>添加 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="354" />
+            <location filename="../../ui/models/points_model.py" line="362" />
             <source>Duplicate {point}</source>
             <translation>复制 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="356" />
+            <location filename="../../ui/models/points_model.py" line="364" />
             <source>Duplicate {n} points</source>
             <translation>复制 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="375" />
+            <location filename="../../ui/models/points_model.py" line="383" />
             <source>Delete {point}</source>
             <translation>删除 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="377" />
+            <location filename="../../ui/models/points_model.py" line="385" />
             <source>Delete {n} points</source>
             <translation>删除 {n} 个点</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="393" />
+            <location filename="../../ui/models/points_model.py" line="401" />
             <source>Move up</source>
             <translation>上移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="393" />
+            <location filename="../../ui/models/points_model.py" line="401" />
             <source>Move down</source>
             <translation>下移</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="416" />
+            <location filename="../../ui/models/points_model.py" line="424" />
             <source>Teach {point}</source>
             <translation>示教 {point}</translation>
         </message>
         <message>
-            <location filename="../../ui/models/points_model.py" line="436" />
+            <location filename="../../ui/models/points_model.py" line="444" />
             <source>Import {n} points</source>
             <translation>导入 {n} 个点</translation>
         </message>
@@ -5958,112 +6192,113 @@ Remove them all?</source>
     <context>
         <name>SafetyMenu</name>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="143" />
+            <location filename="../../ui/controllers/safety_menu.py" line="145" />
             <source>&amp;Safety</source>
+            <extracomment>measured stopping's summary lines for the bundle (app/safety/stopping.py; None: none kept)</extracomment>
             <translation>安全(&amp;S)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="144" />
+            <location filename="../../ui/controllers/safety_menu.py" line="146" />
             <source>Log &amp;in…</source>
             <translation>登录(&amp;I)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="145" />
+            <location filename="../../ui/controllers/safety_menu.py" line="147" />
             <source>Log &amp;out (operator)</source>
             <translation>注销(&amp;O)（回到操作员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="146" />
+            <location filename="../../ui/controllers/safety_menu.py" line="148" />
             <source>&amp;Reduced speed</source>
             <translation>降速模式(&amp;R)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="147" />
+            <location filename="../../ui/controllers/safety_menu.py" line="149" />
             <source>Safety &amp;envelope…</source>
             <translation>安全范围(&amp;E)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="148" />
+            <location filename="../../ui/controllers/safety_menu.py" line="150" />
             <source>Re&amp;gister profile…</source>
             <translation>寄存器配置(&amp;G)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="150" />
+            <location filename="../../ui/controllers/safety_menu.py" line="152" />
             <source>Word order, unit id, completion rule, poll timeout (administrator)</source>
             <translation>字序、从站地址、完成判定、轮询超时（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="152" />
+            <location filename="../../ui/controllers/safety_menu.py" line="154" />
             <source>&amp;Passwords and lock…</source>
             <translation>密码与锁定(&amp;P)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="154" />
+            <location filename="../../ui/controllers/safety_menu.py" line="156" />
             <source>Set, change or clear passwords; the idle lock time (administrator)</source>
             <translation>设置、修改或清除密码；空闲锁定时间（管理员）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="156" />
+            <location filename="../../ui/controllers/safety_menu.py" line="158" />
             <source>&amp;Audit trail…</source>
             <translation>审计记录(&amp;A)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="157" />
+            <location filename="../../ui/controllers/safety_menu.py" line="159" />
             <source>Write a &amp;support bundle…</source>
             <translation>生成支持包(&amp;S)…</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="171" />
+            <location filename="../../ui/controllers/safety_menu.py" line="173" />
             <source>Role: {role} · reduced speed</source>
             <translation>角色：{role} · 降速模式</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="171" />
+            <location filename="../../ui/controllers/safety_menu.py" line="173" />
             <source>Role: {role}</source>
             <translation>角色：{role}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="181" />
+            <location filename="../../ui/controllers/safety_menu.py" line="183" />
             <source>Cap jog and move speeds (anyone may switch it on)</source>
             <translation>限制点动与移动速度（任何人都可开启）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="194" />
+            <location filename="../../ui/controllers/safety_menu.py" line="196" />
             <source>safety</source>
             <translation>安全</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="257" />
+            <location filename="../../ui/controllers/safety_menu.py" line="259" />
             <source>The register profile could not be saved: {why}</source>
             <translation>寄存器配置无法保存：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="262" />
+            <location filename="../../ui/controllers/safety_menu.py" line="264" />
             <source>Register profile “{name}” saved (revision {rev})</source>
             <translation>寄存器配置“{name}”已保存（第 {rev} 版）</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="276" />
+            <location filename="../../ui/controllers/safety_menu.py" line="278" />
             <source>Zip files (*.zip)</source>
             <translation>Zip 文件 (*.zip)</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="283" />
+            <location filename="../../ui/controllers/safety_menu.py" line="285" />
             <source>Write a support bundle</source>
             <translation>生成支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="314" />
+            <location filename="../../ui/controllers/safety_menu.py" line="317" />
             <source>The support bundle could not be written: {why}</source>
             <translation>无法生成支持包：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="317" />
+            <location filename="../../ui/controllers/safety_menu.py" line="320" />
             <source>Support bundle</source>
             <translation>支持包</translation>
         </message>
         <message>
-            <location filename="../../ui/controllers/safety_menu.py" line="323" />
+            <location filename="../../ui/controllers/safety_menu.py" line="326" />
             <source>Support bundle written: {file} ({n} files)</source>
             <translation>支持包已生成：{file}（{n} 个文件）</translation>
         </message>

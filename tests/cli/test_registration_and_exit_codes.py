@@ -88,8 +88,8 @@ def test_every_leaf_command_has_a_handler() -> None:
         if path and not any(isinstance(a, argparse._SubParsersAction) for a in sub._actions)
     ]
     assert (
-        len(leaves) == 25
-    )  # 14 controller (point create, program run) + 4 points + run + selftest + 5 offline
+        len(leaves) == 26
+    )  # 14 controller (point create, program run) + 5 points (diff) + run + selftest + 5 offline
     missing = [path for path, sub in leaves if not callable(sub.get_default("handler"))]
     assert missing == []
 

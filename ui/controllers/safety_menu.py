@@ -68,6 +68,8 @@ class SafetyParts:
     planner_tab: LazyTab[PlannerPanel]
     view3d: View3DHost
     refusal_line: MotionRefusalLine  # a refused motion is said under the motion buttons too
+    #: measured stopping's summary lines for the bundle (app/safety/stopping.py; None: none kept)
+    stopping: Callable[[], list[str]] | None = None
 
 
 class SafetyMenu(QObject):
@@ -309,6 +311,7 @@ class SafetyMenu(QObject):
                     audit_dir=self.safety.audit_dir,
                     events=events,
                     traffic=traffic,
+                    stopping=parts.stopping() if parts.stopping is not None else None,
                 )
         except (OSError, TeachPadError) as exc:
             why = self.tr("The support bundle could not be written: {why}").format(why=str(exc)[:200])

@@ -39,6 +39,7 @@ from app.points.ledger import PointLedger
 from app.points.ledger_import import ImportMode, ImportReport
 from app.points.point import SyncState, TempPoint, make_point, point_from_pose, with_field
 from app.points.project_model import Project
+from app.points.provenance import Origin
 from app.points.upload import UploadReport, apply_upload
 from app.protocol.registers import TOOL_NONE
 from ui.messages import refusal_text
@@ -61,6 +62,7 @@ from ui.models.point_columns import (
     tool_display,
 )
 from ui.models.point_commands import ReplaceAllCommand, follow_id
+from ui.models.point_provenance import ProvenanceStamps, provenance_tip
 from ui.models.undo_list import (
     InsertRowsCommand,
     MoveRowsCommand,
@@ -90,6 +92,8 @@ class PointsModel(UndoableListModel):
         self._headers: tuple[str, ...] = ()
         self._header_tips: dict[int, str] = {}
         self._brushes: dict[SyncState, tuple[QBrush, QBrush]] = {}  # made by the first row drawn
+        #: how the points made here are stamped (the window tells it the controller the link reaches)
+        self.stamps = ProvenanceStamps()
         self._seed_controller_copy()
         self.retranslate()
 
@@ -230,7 +234,7 @@ class PointsModel(UndoableListModel):
             return point.note
         if name == "tool":
             return self.tr("Tool frame {value}").format(value=point.tool)
-        return None
+        return provenance_tip(point.made)  # the id, name, pose and axes cells: how it was made
 
     def _alignment(self, _point: TempPoint, column: int) -> int:
         if column in NUMBER_COLUMNS:
@@ -289,6 +293,7 @@ class PointsModel(UndoableListModel):
         new = with_field(old, name, value, self.ledger.limits)
         if new == old:
             return False
+        new = replace(new, made=self.stamps.edited(old.made))
         if name == "id":
             other = self.ledger.row_of(new.id)
             if other is not None and other != row:
@@ -319,6 +324,7 @@ class PointsModel(UndoableListModel):
     ) -> int:
         """A new point (next free id) at ``row`` (default: the end); returns its row."""
         point = make_point(self.next_id(), name, pose or (0.0,) * 6, tool=tool, limits=self.ledger.limits)
+        point = replace(point, made=self.stamps.made(Origin.TYPED))
         row = len(self.ledger) if row is None else max(0, min(row, len(self.ledger)))
         self._stack.push(
             InsertRowsCommand(
@@ -348,7 +354,9 @@ class PointsModel(UndoableListModel):
             source = self.ledger[row]
             new_id = self._free_id_after(source.id, used)
             used.add(new_id)
-            copy = replace(source, id=new_id, sync=SyncState.CHANGED, sync_error="")
+            # a copy's values were made as its source's were: its history, edited now
+            made = self.stamps.edited(source.made)
+            copy = replace(source, id=new_id, sync=SyncState.CHANGED, sync_error="", made=made)
             copies.append((row + 1 + offset, copy))
         text = (
             self.tr("Duplicate {point}").format(point=self.ledger[chosen[0]].label)
@@ -400,7 +408,7 @@ class PointsModel(UndoableListModel):
 
         It is on the controller by construction. Returns its row."""
         point = point_from_pose(point_id, pose, name, tool=tool, limits=self.ledger.limits)
-        point = replace(point, sync=SyncState.ON_CONTROLLER)
+        point = replace(point, sync=SyncState.ON_CONTROLLER, made=self.stamps.made(Origin.TAUGHT))
         if self.ledger.row_of(point_id) is not None:
             taken = self.ledger.point(point_id).label
             raise FieldError(

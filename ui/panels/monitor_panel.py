@@ -38,6 +38,7 @@ from PySide6.QtWidgets import (
 
 from app.link.state import RobotState
 from app.models import Pose
+from app.safety.stopping import StopKind, StopMeasurement
 from ui.display_clock import DISPLAY_INTERVAL_MS, DisplayClock
 from ui.models.ring_buffer import RingBuffer
 from ui.palette import COLOR_NEUTRAL
@@ -143,6 +144,15 @@ class MonitorPanel(QWidget):
 
         self._status = QLabel(self)
         self._status.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+        # measured stopping (ui/controllers/stop_timing.py): "Last stop: 180 ms, 4.2 mm"
+        self.last_stop_label = QLabel(self)
+        self.last_stop_label.setObjectName("LastStopLabel")
+        self._last_stop: StopMeasurement | None = None
+        self._stops_measured = 0
+        bottom = QHBoxLayout()
+        bottom.setContentsMargins(0, 0, 0, 0)
+        bottom.addWidget(self._status, 1)
+        bottom.addWidget(self.last_stop_label)
 
         layout = QVBoxLayout(self)
         layout.setContentsMargins(PANEL_MARGIN, PANEL_MARGIN, PANEL_MARGIN, PANEL_MARGIN)
@@ -151,7 +161,7 @@ class MonitorPanel(QWidget):
         layout.addWidget(boxes.axes_box)
         layout.addLayout(controls)
         layout.addWidget(plots, 1)
-        layout.addWidget(self._status)
+        layout.addLayout(bottom)
         self._layout = layout
         self.retranslate()
 
@@ -203,6 +213,7 @@ class MonitorPanel(QWidget):
         self.clear_trace_button.setText(self.tr("Clear trace"))
         self.clear_trace_button.setToolTip(self.tr("Erase the X–Y path trace"))
         self._update_status_text()
+        self._show_last_stop()
         if self._plots_built:
             self._retranslate_plots()
 
@@ -431,6 +442,34 @@ class MonitorPanel(QWidget):
         if not self._fresh:
             text += " — " + self.tr("values stale (grey): no fresh data from the controller")
         self._status.setText(text)
+
+    @Slot(object)
+    def show_last_stop(self, measurement: StopMeasurement) -> None:
+        """A Stop or jog release was measured (``StopTiming.measured``): say how long and how far."""
+        self._last_stop = measurement
+        self._stops_measured += 1
+        self._show_last_stop()
+
+    def _show_last_stop(self) -> None:
+        m = self._last_stop
+        if m is None:
+            self.last_stop_label.setText(self.tr("Last stop: not measured yet"))
+        else:
+            head = self.tr("Last stop:") if m.kind is StopKind.STOP else self.tr("Last jog release:")
+            body = (
+                self.tr("{ms} ms, {mm} mm").format(ms=m.ms, mm=f"{m.distance_mm:.1f}")
+                if m.still
+                else self.tr("not seen still within {s} s ({mm} mm)").format(
+                    s=f"{m.timeout:g}", mm=f"{m.distance_mm:.1f}"
+                )
+            )
+            self.last_stop_label.setText(f"{head} {body}")
+        self.last_stop_label.setToolTip(
+            self.tr(
+                "Measured stopping: from the click on Stop (or a jog's release) to the arm seen still "
+                "(two polls alike), and the distance it travelled meanwhile. {n} measured in this session."
+            ).format(n=self._stops_measured)
+        )
 
     @Slot(int)
     def _on_window_index(self, index: int) -> None:
