@@ -13,8 +13,11 @@ What the specification asks of an edge node, and how it is met here:
   ``Node Control/Rebirth`` metric), then a **DBIRTH** per answering controller (every metric, name and
   alias), then **DDATA** by exception: only the metrics that moved past their deadband, by alias only.
 * ``seq`` counts every message of the node but NDEATH, 0..255 and round again; NBIRTH resets it to 0.
-* A controller that stops answering gets a **DDEATH** at its first failed poll; a **DBIRTH** when it
-  answers again. **NCMD** ``Node Control/Rebirth`` = true: NBIRTH and every DBIRTH again (same bdSeq).
+* A controller that stops answering gets a **DDEATH** once it has been silent
+  ``GatewayTiming.death_after`` (0.2 s) since its last answer, not at a poll timeout: a late answer
+  within that window is taken, and no consumer sees a busy PC's slow poll as a robot dying
+  (:mod:`app.gateway.poller` says the rule); a **DBIRTH** when it answers again. **NCMD**
+  ``Node Control/Rebirth`` = true: NBIRTH and every DBIRTH again (same bdSeq).
 * **While the broker is away** the DDATA the controllers' changes would have been are kept, at most
   ``history_limit`` (the oldest dropped first), and published after the next session's births with
   every metric ``is_historical``; how many were dropped is the NBIRTH's ``Node Info/History dropped``
