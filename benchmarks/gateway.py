@@ -248,9 +248,12 @@ def _edge_node(ports: Sequence[int], broker_port: int, poll_timeout: float | Non
         answers_at: dict[str, list[float]]
         handed_over: list[float]  # s from an answer to its DDATA handed to paho (the gateway's share)
 
-        def answered(self, device: str, reading: Reading) -> None:
+        def answered(self, device: str, reading: Reading) -> None:  # the poller's thread
             self.answers_at.setdefault(device, []).append(reading.answered_at)
             super().answered(device, reading)
+
+        def _answered(self, device: str, reading: Reading) -> None:  # the publisher thread
+            super()._answered(device, reading)
             self.handed_over.append(time.monotonic() - reading.answered_at)
 
     cell = Cell(

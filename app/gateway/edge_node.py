@@ -33,9 +33,13 @@ What the specification asks of an edge node, and how it is met here:
   robot (:mod:`app.gateway.plant`). What became of it is the device's ``Plant/Last command result``
   (a DDATA). The DBIRTH advertises the writable metrics a robot has.
 
-Threads: paho's network thread (connect, NCMD, DCMD) and one poller thread per controller call in
-here; one lock orders everything the node publishes, so ``seq`` goes out in order. A DCMD's writes
-are made in its robot's poller thread (its client's only thread), never in paho's.
+Threads: paho's network thread (connect, NCMD, DCMD), one poller thread per controller and the
+node's publisher thread. A poller only hands its answers and silences over (a queue, in order): the
+publisher thread turns them into DBIRTH / DDATA / DDEATH, a batch at a time under the node's lock,
+so 64 pollers never queue on that lock (measured: 30 ms each answer on the 2-core machine when they
+took it themselves) and a poller is never late for its next poll because another's DDATA was being
+published. One lock orders everything the node publishes, so ``seq`` goes out in order. A DCMD's
+writes are made in its robot's poller thread (its client's only thread), never in paho's.
 """
 
 from __future__ import annotations
@@ -44,6 +48,7 @@ import dataclasses
 import json
 import logging
 import os
+import queue
 import ssl
 import threading
 import time
@@ -187,6 +192,9 @@ class EdgeNode:
         self._history: deque[tuple[str, Any]] = deque(maxlen=max(1, limit))
         self.history_dropped = 0  # DDATA the bound dropped while the broker was away, since the start
         self._client = self._make_client()
+        # the pollers' answers (a Reading) and silences (the reason) for the publisher thread
+        self._inbox: queue.SimpleQueue[tuple[str, Reading | str] | None] = queue.SimpleQueue()
+        self._publisher: threading.Thread | None = None
 
     def _read_envelope(self, controllers: tuple[CellController, ...]) -> None:
         """The safety envelope in force (the GUI's and the CLI's), read once when a robot has plant
@@ -266,6 +274,8 @@ class EdgeNode:
         self._running = True
         self._client.connect_async(self._broker.host, self._broker.port, keepalive=self.timing.keepalive)
         self._client.loop_start()
+        self._publisher = threading.Thread(target=self._publish_loop, name="gateway-publish", daemon=True)
+        self._publisher.start()
         for poller in self._pollers.values():
             poller.start()
 
@@ -276,6 +286,10 @@ class EdgeNode:
         self._running = False
         for poller in list(self._pollers.values()):
             poller.stop()
+        if self._publisher is not None:  # what the pollers told before they stopped goes out first
+            self._inbox.put(None)
+            self._publisher.join()
+            self._publisher = None
         with self._lock:
             online, self._online = self._online, False
             if online:
@@ -571,24 +585,49 @@ class EdgeNode:
                 device.sent[spec.name] = now
         return message if message.metrics else None
 
-    # -- the pollers (their threads) ------------------------------------------------------
+    # -- the pollers (their threads) hand over; the publisher thread publishes -----------------
     def answered(self, device: str, reading: Reading) -> None:
-        with self._lock:
-            self.answers += 1
-            state = self._devices.get(device)
-            if state is None:  # it left the cell
+        self._inbox.put((device, reading))
+
+    def silent(self, device: str, reason: str) -> None:
+        self._inbox.put((device, reason))
+
+    def _publish_loop(self) -> None:
+        """The publisher thread: what the pollers told, in order, a batch per hold of the lock."""
+        inbox = self._inbox
+        while (item := inbox.get()) is not None:
+            batch = [item]
+            while not inbox.empty() and (item := inbox.get_nowait()) is not None:
+                batch.append(item)
+            with self._lock:
+                for device, told in batch:
+                    try:
+                        if isinstance(told, str):
+                            self._silent(device, told)
+                        else:
+                            self._answered(device, told)
+                    except Exception:  # one device's bad answer must not end the publishing
+                        _log.exception("%s: its answer could not be published", device)
+            if item is None:
                 return
-            if reading.clock is not None:
-                state.clock = clock_text(reading.clock)
-            freshness = int((time.monotonic() - reading.answered_at) * 1000)
-            self._count_cycle(state, reading)
-            state.values = device_values(reading, freshness, state.clock, state.kept)
-            if not state.alive:
-                state.alive = True
-                if self._online:
-                    self._dbirth(state, reading.wall_ms)
-            elif state.sent is not None:  # births told the subscribers its values once
-                self._ddata(state, reading.wall_ms)
+
+    def _answered(self, device: str, reading: Reading) -> None:
+        """An answer (the publisher thread, under the lock): the device's values, its DBIRTH or DDATA."""
+        self.answers += 1
+        state = self._devices.get(device)
+        if state is None:  # it left the cell
+            return
+        if reading.clock is not None:
+            state.clock = clock_text(reading.clock)
+        freshness = int((time.monotonic() - reading.answered_at) * 1000)
+        self._count_cycle(state, reading)
+        state.values = device_values(reading, freshness, state.clock, state.kept)
+        if not state.alive:
+            state.alive = True
+            if self._online:
+                self._dbirth(state, reading.wall_ms)
+        elif state.sent is not None:  # births told the subscribers its values once
+            self._ddata(state, reading.wall_ms)
 
     @staticmethod
     def _count_cycle(state: _Device, reading: Reading) -> None:
@@ -601,17 +640,17 @@ class EdgeNode:
             name = CYCLE_METRICS[cycle]
             state.kept[name] = int(state.kept[name] or 0) + 1
 
-    def silent(self, device: str, reason: str) -> None:
-        with self._lock:
-            state = self._devices.get(device)
-            if state is None:
-                return
-            if not state.alive:
-                if state.never_said and state.values is None:
-                    _log.warning("%s does not answer (trying again): %s", device, reason)
-                state.never_said = False
-                return
-            state.alive = False
-            _log.warning("%s stopped answering: %s", device, reason)
-            if self._online:
-                self._publish(self.topic("DDEATH", device), pb.Payload(timestamp=_now_ms()))
+    def _silent(self, device: str, reason: str) -> None:
+        """A failed poll (the publisher thread, under the lock): the device's DDEATH when it was alive."""
+        state = self._devices.get(device)
+        if state is None:
+            return
+        if not state.alive:
+            if state.never_said and state.values is None:
+                _log.warning("%s does not answer (trying again): %s", device, reason)
+            state.never_said = False
+            return
+        state.alive = False
+        _log.warning("%s stopped answering: %s", device, reason)
+        if self._online:
+            self._publish(self.topic("DDEATH", device), pb.Payload(timestamp=_now_ms()))
