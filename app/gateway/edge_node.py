@@ -76,6 +76,7 @@ from app.gateway.metrics import (
     PLANT_RESULT,
     REBIRTH,
     REBIRTH_ALIAS,
+    MetricSpec,
     Reading,
     changed,
     clock_text,
@@ -123,6 +124,7 @@ class _Device:
     name: str
     index: int
     metrics: tuple[int, ...]  # its metrics' indexes in ALL_METRICS (app.gateway.metrics.device_metrics)
+    plan: tuple[tuple[MetricSpec, int], ...]  # those metrics and their aliases, in order
     kept: dict[str, pb.Value] = field(default_factory=_kept)
     commands: int = 0  # DCMD metrics received (their numbers)
     alive: bool = False  # answering (a DBIRTH went out, or will on the next session)
@@ -209,7 +211,9 @@ class EdgeNode:
         return controller if self._writes else dataclasses.replace(controller, plant_writes=())
 
     def _device(self, controller: CellController, index: int) -> _Device:
-        return _Device(controller.name, index, device_metrics(self._allowed(controller)))
+        metrics = device_metrics(self._allowed(controller))
+        plan = tuple((ALL_METRICS[i], device_alias(index, i)) for i in metrics)
+        return _Device(controller.name, index, metrics, plan)
 
     def _poller(self, controller: CellController) -> ControllerPoller:
         """Its poller, and its plant writer (which refuses what is not enabled; the poller only
@@ -573,17 +577,30 @@ class EdgeNode:
         self._history.append((topic, message))
 
     def _changes(self, device: _Device, stamp: int) -> Any:
-        """A DDATA payload of what moved past its deadband since the last one (None: nothing)."""
-        assert device.values is not None and device.sent is not None
+        """A DDATA payload of what moved past its deadband since the last one (None: nothing).
+
+        Every poll of every controller passes here (640 a second at 64 controllers and 10 Hz): a
+        value equal to the one sent is skipped before the deadband rule (most are: mode, alarms,
+        a robot standing still), and the payload is made only when something is to be sent."""
+        values, sent = device.values, device.sent
+        assert values is not None and sent is not None
+        moved = []
+        deadbands = self._deadbands
+        for spec, alias in device.plan:
+            name = spec.name
+            now, before = values[name], sent[name]
+            if now == before and type(now) is type(before):  # (NaN != NaN: the rule decides)
+                continue
+            if changed(spec, before, now, deadbands):
+                moved.append((spec.datatype, alias, now))
+                sent[name] = now
+        if not moved:
+            return None
         message = pb.Payload(timestamp=stamp)
-        for i in device.metrics:
-            spec = ALL_METRICS[i]
-            now = device.values[spec.name]
-            if changed(spec, device.sent[spec.name], now, self._deadbands):
-                metric = message.metrics.add(alias=device_alias(device.index, i), timestamp=stamp)
-                pb.set_value(metric, spec.datatype, now)
-                device.sent[spec.name] = now
-        return message if message.metrics else None
+        add = message.metrics.add
+        for datatype, alias, now in moved:
+            pb.set_value(add(alias=alias, timestamp=stamp), datatype, now)
+        return message
 
     # -- the pollers (their threads) hand over; the publisher thread publishes -----------------
     def answered(self, device: str, reading: Reading) -> None:
