@@ -34,7 +34,7 @@ from typing import Protocol
 
 from app import timing
 from app.cell.cell_file import CellController
-from app.errors import TeachPadError
+from app.errors import ResponseTimeout, TeachPadError
 from app.gateway.metrics import Reading
 from app.gateway.plant import PlantWriter
 from app.link.client import RobotClient
@@ -142,9 +142,13 @@ class ControllerPoller:
         except TeachPadError as exc:
             self.errors += 1
             self._failures += 1
+            reason = str(exc)
+            if isinstance(exc, ResponseTimeout) and self._answered_at is not None:
+                silent_ms = (time.monotonic() - self._answered_at) * 1000.0
+                reason = f"no answer for {silent_ms:.0f} ms since its last one ({reason})"
             self._answered_at = None
-            _log.info("%s: poll failed: %s", self.name, exc)
-            self._listener.silent(self.name, str(exc))
+            _log.info("%s: poll failed: %s", self.name, reason)
+            self._listener.silent(self.name, reason)
             return False
         self._failures = 0
         if clock is not None:
