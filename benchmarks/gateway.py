@@ -12,6 +12,10 @@
   notes its arrival).
 * ``bare_64``: a bare pymodbus read loop (a thread per controller, the same two reads, 10 Hz) on
   the same simulators in the same run: the floor the gateway is compared to.
+* ``ddeath_64``: the 64 again, and five times one simulator process (8 controllers) stopped by
+  SIGSTOP: SIGSTOP -> DDEATH at the subscriber, the share within the issue's 250 ms, and the
+  DDEATHs of controllers that were not stopped (false deaths: the gateway's death rule,
+  :mod:`app.gateway.poller`, against a busy machine's late answers).
 * ``dead_one_of_16``: 16 controllers at 10 Hz, all alive, then one of them stopped (SIGSTOP of its
   own simulator process: it accepts nothing and answers nothing); the other 15's poll period p99
   in both runs.
