@@ -184,4 +184,6 @@ class ControllerPoller:
         self._listener.answered(self.name, reading)
         if self.writer is not None:
             self.writer.after_poll(client, status, pose)
+            # a plant command's status reads are answers too: its writes' time is no silence
+            self._answered_at = max(answered_at, client.status_read_at)
         return status.clock
