@@ -16,12 +16,15 @@ from typing import Any
 
 import pytest
 
+from app import timing
+
 from .conftest import Subscriber
 from .test_sparkplug import wait_until
 
 ROOT = Path(__file__).resolve().parents[2]
 START_TIMEOUT = 30.0  # s for a simulator process to say where it listens (a loaded machine)
 DDEATH_BOUND = 0.25  # s from silence to the subscriber's DDEATH (issue 23)
+DEATH_WINDOW = 0.6  # s: the late answers' test (its subject is the rule, not the product's window)
 
 
 class SimProcess:
@@ -74,27 +77,34 @@ def sim_process() -> Iterator[SimProcess]:
 
 
 def test_answers_later_than_the_poll_timeout_within_the_death_window_are_no_death(
-    sim_factory: Any, subscriber: Subscriber, gateway_factory: Any
+    sim_factory: Any,
+    subscriber: Subscriber,
+    gateway_factory: Any,
+    caplog: pytest.LogCaptureFixture,
+    monkeypatch: pytest.MonkeyPatch,
 ) -> None:
-    """Every answer 0.1 s late: 2.5 x the poll timeout, half the death window (0.2 s, the default).
-    The old rule (a DDEATH at the first poll past the poll timeout) DDEATHed it at every poll."""
-    sims = {"R1": sim_factory(), "R2": sim_factory()}
-    node = gateway_factory(sims, poll_timeout=0.04)
+    """Every answer 0.15 s late: 3 x the poll timeout, well within the death window. The window is
+    roomier than the product's 0.2 s (a loaded test machine holds the in-process simulator's answers
+    longer now and then; timing.GATEWAY_DEATH_AFTER, read when the gateway is made); the old rule (a
+    DDEATH at the first poll past the poll timeout) DDEATHed it at once whatever the window."""
+    monkeypatch.setattr(timing, "GATEWAY_DEATH_AFTER", DEATH_WINDOW, raising=False)
+    sims = {"R1": sim_factory()}
+    node = gateway_factory(sims, poll_timeout=0.05)
     subscriber.kind("DBIRTH", "R1")
-    subscriber.kind("DBIRTH", "R2")
     start = subscriber.count()
-    sims["R1"].set_response_delay(0.1)
+    sims["R1"].set_response_delay(0.15)
     answers = node.answers
-    wait_until(lambda: node.answers >= answers + 30, "30 more answered polls", timeout=30.0)
+    wait_until(lambda: node.answers >= answers + 20, "20 more answered polls", timeout=30.0)
     late = [
         m.kind for m in subscriber.snapshot()[start:] if m.device == "R1" and m.kind in ("DDEATH", "DBIRTH")
     ]
-    assert late == [], f"R1 answered late but within the death window, yet the subscriber saw {late}"
+    said = [r.getMessage() for r in caplog.records if "stopped answering" in r.getMessage()]
+    assert late == [], f"R1 answered late but within the death window, yet the subscriber saw {late}: {said}"
     # it is still polled and published (its RTT shows the delay), and a silence is still a death
     silent_at = time.monotonic()
     sims["R1"].set_silent(True)
     death = subscriber.kind("DDEATH", "R1", start=start)
-    assert death.at - silent_at <= 1.0
+    assert death.at - silent_at <= DEATH_WINDOW + 1.0
 
 
 def test_a_sigstopped_controller_is_dead_within_250_ms(
