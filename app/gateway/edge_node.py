@@ -36,13 +36,13 @@ What the specification asks of an edge node, and how it is met here:
 Threads: paho's network thread (connect, NCMD, DCMD), one poller thread per controller and the
 node's publisher thread. A poller puts its answers and silences in a queue (in order) and, when the
 node's lock is free, publishes what waits there itself (DBIRTH / DDATA / DDEATH); when the lock is
-held it does not wait for it: the holder drains the queue before it lets go, and the publisher
-thread takes what is left. So 64 pollers never queue on that lock (measured: 30 ms an answer on the
-2-core machine when each took it blocking) and none is late for its next poll because another's
-DDATA was being published, while an answer is mostly published by the thread that has just run
-(no hand-over to a thread that must be scheduled first). One lock orders everything the node
-publishes, so ``seq`` goes out in order. A DCMD's
-writes are made in its robot's poller thread (its client's only thread), never in paho's.
+held it does not wait for it: it wakes the publisher thread, which takes what waits once the lock
+is free (another poller holding it may take it first). So 64 pollers never queue on that lock
+(measured: 30 ms an answer on the 2-core machine when each took it blocking) and none is late for
+its next poll because another's DDATA was being published, while an answer is mostly published by
+the thread that has just run (no hand-over to a thread that must be scheduled first). One lock
+orders everything the node publishes, so ``seq`` goes out in order. A DCMD's writes are made in its
+robot's poller thread (its client's only thread), never in paho's.
 """
 
 from __future__ import annotations
@@ -303,7 +303,6 @@ class EdgeNode:
             self._publisher = None
         with self._lock:
             self._drain()
-        with self._lock:
             online, self._online = self._online, False
             if online:
                 info = self._client.publish(self.topic("NDEATH"), self._ndeath(), qos=1)
@@ -621,8 +620,9 @@ class EdgeNode:
         self._hand_over()
 
     def _hand_over(self) -> None:
-        """Publish what is waiting when the lock is free; else leave it to whoever holds the lock
-        (it drains the queue before it lets go) and wake the publisher thread for what it left."""
+        """Publish what is waiting when the lock is free; else, without waiting for it, wake the
+        publisher thread, which takes what waits once the lock is free (a poller holding it may have
+        taken it already)."""
         if self._lock.acquire(blocking=False):
             try:
                 self._drain()
@@ -656,7 +656,7 @@ class EdgeNode:
                 _log.exception("%s: its answer could not be published", device)
 
     def _answered(self, device: str, reading: Reading) -> None:
-        """An answer (the publisher thread, under the lock): the device's values, its DBIRTH or DDATA."""
+        """An answer (under the lock): the device's values, its DBIRTH or DDATA."""
         self.answers += 1
         state = self._devices.get(device)
         if state is None:  # it left the cell
@@ -685,7 +685,7 @@ class EdgeNode:
             state.kept[name] = int(state.kept[name] or 0) + 1
 
     def _silent(self, device: str, reason: str) -> None:
-        """A failed poll (the publisher thread, under the lock): the device's DDEATH when it was alive."""
+        """A failed poll (under the lock): the device's DDEATH when it was alive."""
         state = self._devices.get(device)
         if state is None:
             return
