@@ -107,7 +107,10 @@ SIM_SLOW_PICKUP = (0.005, 0.025)
 SIM_SLOW_ZERO = (0.002, 0.015)
 
 # --- teachpad-gateway, the Sparkplug B edge node (app/gateway; issue 23) --------------------------
-GATEWAY_POLL_HZ = 20.0  # polls per controller per s (a silent one: DDEATH within 1 / this + poll timeout)
+GATEWAY_POLL_HZ = 20.0  # polls per controller per s (a silent one: DDEATH by the rule below)
+# s: a controller is dead (DDEATH) once it has not answered this long since its last answer, whatever the
+# poll timeout (app/gateway/poller.py): within the issue's 250 ms of silence; a busy PC's late answers kept
+GATEWAY_DEATH_AFTER = 0.2
 GATEWAY_RECONNECT_BACKOFF = (0.2, 0.5, 1.0, 2.0)  # s between polls of a controller that does not answer
 GATEWAY_KEEPALIVE = 30  # s, the MQTT keepalive: the broker sends NDEATH at most 1.5 x this after a crash
 GATEWAY_BROKER_RETRY = (

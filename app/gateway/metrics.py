@@ -153,15 +153,22 @@ class Reading:
     wall_ms: int  # the same moment as ms since the epoch (the metrics' timestamp)
 
 
+_POSE_NAMES = tuple(f"Pose/{axis}" for axis in "XYZABC")
+_JOINT_NAMES = tuple(f"Joints/J{i}" for i in range(1, 7))
+_EXTERNAL_NAMES = tuple(spec.name for spec in EXTERNAL_METRICS)
+_ALARM_NAMES = tuple((ALARM_METRIC_NAMES[bit], int(bit)) for bit in ALARM_BITS)  # ints: no enum op a poll
+_NO_JOINTS = (math.nan,) * 6
+
+
 def device_values(
     reading: Reading, freshness_ms: int, clock: str | None, kept: Mapping[str, Value]
 ) -> dict[str, Value]:
     """Every metric's value for ``reading`` (the names of :data:`ALL_METRICS`): what the poll read,
     and ``kept``, what the gateway holds of the device (the cycle counters, the plant's metrics)."""
     pose, status = reading.pose, reading.status
-    joints = pose.joints or (math.nan,) * 6
-    values: dict[str, Value] = {f"Pose/{axis}": v for axis, v in zip("XYZABC", pose.xyzabc, strict=True)}
-    values.update({f"Joints/J{i + 1}": float(v) for i, v in enumerate(joints[:6])})
+    joints = pose.joints or _NO_JOINTS
+    values: dict[str, Value] = dict(zip(_POSE_NAMES, pose.xyzabc, strict=True))
+    values.update(zip(_JOINT_NAMES, map(float, joints[:6]), strict=False))
     alarms = int(status.alarms)
     values.update(
         {
@@ -175,8 +182,8 @@ def device_values(
             "Controller/Clock": clock,
         }
     )
-    values.update({ALARM_METRIC_NAMES[bit]: bool(alarms & bit) for bit in ALARM_BITS})
-    values.update({spec.name: float(v) for spec, v in zip(EXTERNAL_METRICS, pose.ext, strict=True)})
+    values.update((name, bool(alarms & bit)) for name, bit in _ALARM_NAMES)
+    values.update(zip(_EXTERNAL_NAMES, map(float, pose.ext), strict=True))
     values.update(kept)
     return values
 

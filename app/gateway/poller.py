@@ -4,11 +4,23 @@ Monitor-only unless the plant may write to the controller: the :class:`~app.link
 is made with ``monitor_only=True`` (the one write guard refuses every write); with plant writes
 enabled in the cell file it is writable, audited, and its :class:`~app.gateway.plant.PlantWriter`
 makes the plant's commands between two polls (:mod:`app.gateway.plant`). The poller reads the
-status block (with the clock every :attr:`GatewayTiming.clock_period`), then the pose block, each
-with the poll timeout (``settings.effective_poll_timeout``: 0.15 s over TCP). A poll that fails
-(no answer in time, a refused or lost connection, a malformed answer) is reported at once
-(:meth:`DeviceListener.silent`), and the next tries come after :attr:`GatewayTiming.backoff`; a
-dead controller costs the others nothing (each has its own thread and link).
+status block (with the clock every :attr:`GatewayTiming.clock_period`), then the pose block.
+
+**When a controller is dead** (the rule behind the gateway's DDEATH): when it has not answered for
+:attr:`GatewayTiming.death_after` (0.2 s, :data:`app.timing.GATEWAY_DEATH_AFTER`) since its *last
+answer* -- not when one request outlived the poll timeout. Each read waits for its answer until
+that moment, so an answer that comes late (a busy PC, a loaded controller) is still taken and the
+controller stays alive; a request the gateway itself sent late (its own thread late to run) still
+gets half the window. So a controller that goes silent (SIGSTOP, unplugged) is dead at most
+``death_after`` after its last answer, within the issue's 250 ms of silence with room for the
+DDEATH's way to the broker; one that answers, however late, within the window is never dead. The
+window is never shorter than the poll timeout (``settings.effective_poll_timeout``: 0.15 s over
+TCP, by baud over RTU: a slow serial line's answers take that long on the wire). A controller that
+is not alive (before its first answer, after its death) gets the whole window per read.
+
+A poll that fails (the window ran out, a refused or lost connection, a malformed answer) is reported
+at once (:meth:`DeviceListener.silent`), and the next tries come after :attr:`GatewayTiming.backoff`;
+a dead controller costs the others nothing (each has its own thread and link).
 """
 
 from __future__ import annotations
@@ -22,7 +34,7 @@ from typing import Protocol
 
 from app import timing
 from app.cell.cell_file import CellController
-from app.errors import TeachPadError
+from app.errors import ResponseTimeout, TeachPadError
 from app.gateway.metrics import Reading
 from app.gateway.plant import PlantWriter
 from app.link.client import RobotClient
@@ -47,6 +59,7 @@ class GatewayTiming:
     keepalive: int = field(default_factory=lambda: timing.GATEWAY_KEEPALIVE)
     broker_retry: tuple[int, int] = field(default_factory=lambda: timing.GATEWAY_BROKER_RETRY)
     clock_period: float = field(default_factory=lambda: timing.GATEWAY_CLOCK_PERIOD)
+    death_after: float = field(default_factory=lambda: timing.GATEWAY_DEATH_AFTER)  # s of silence: dead
     stop_wait: float = field(default_factory=lambda: timing.GATEWAY_STOP_WAIT)
 
 
@@ -85,6 +98,8 @@ class ControllerPoller:
         self.errors = 0  # failed polls since the start
         self._failures = 0  # failed polls in a row
         self._next_clock = 0.0
+        self._answered_at: float | None = None  # monotonic time of its last answer (None: not alive)
+        self._window = max(gateway.death_after, settings.effective_poll_timeout)
 
     def start(self) -> None:
         self._thread.start()
@@ -127,30 +142,48 @@ class ControllerPoller:
         except TeachPadError as exc:
             self.errors += 1
             self._failures += 1
-            _log.info("%s: poll failed: %s", self.name, exc)
-            self._listener.silent(self.name, str(exc))
+            reason = str(exc)
+            if isinstance(exc, ResponseTimeout) and self._answered_at is not None:
+                silent_ms = (time.monotonic() - self._answered_at) * 1000.0
+                reason = f"no answer for {silent_ms:.0f} ms since its last one ({reason})"
+            self._answered_at = None
+            _log.info("%s: poll failed: %s", self.name, reason)
+            self._listener.silent(self.name, reason)
             return False
         self._failures = 0
         if clock is not None:
             self._next_clock = time.monotonic() + self._timing.clock_period
         return True
 
+    def _timeout(self) -> float:
+        """How long the next request may wait for its answer (the module's rule): until the
+        controller has been silent the death window since its last answer, at least half the
+        window; the whole window while it is not alive (nothing to tell in time then)."""
+        last, window = self._answered_at, self._window
+        if last is None:
+            return window
+        return max(last + window - time.monotonic(), window / 2)
+
     def _read(self, client: RobotClient) -> ControllerClock | None:
         with_clock = time.monotonic() >= self._next_clock
         t0 = time.perf_counter()
-        status = client.read_status(with_clock=with_clock, timeout=client.settings.effective_poll_timeout)
+        status = client.read_status(with_clock=with_clock, timeout=self._timeout())
         rtt_ms = (time.perf_counter() - t0) * 1000.0
-        pose = client.read_pose(timeout=client.settings.effective_poll_timeout)
+        self._answered_at = time.monotonic()
+        pose = client.read_pose(timeout=self._timeout())
+        answered_at = self._answered_at = time.monotonic()
         reading = Reading(
             pose=pose,
             status=status,
             clock=status.clock,
             rtt_ms=rtt_ms,
             errors=self.errors,
-            answered_at=time.monotonic(),
+            answered_at=answered_at,
             wall_ms=int(time.time() * 1000),
         )
         self._listener.answered(self.name, reading)
         if self.writer is not None:
             self.writer.after_poll(client, status, pose)
+            # a plant command's status reads are answers too: its writes' time is no silence
+            self._answered_at = max(answered_at, client.status_read_at)
         return status.clock

@@ -55,6 +55,11 @@ def test_the_gateway_suite_quick_run_prints_its_keys_beside_their_goals() -> Non
     # stopped: at most the one answer that was under way when it stopped
     assert _lookup(out, "gateway.dead_one_of_16.one_dead.dead_controller_answers") <= 1
     assert _lookup(out, "gateway.bare_64.poll_period.p99_ms") is not None
+    # every SIGSTOPped controller got its DDEATH (the bound's share is a figure, not asserted here)
+    assert _lookup(out, "gateway.ddeath_64.silenced") > 0
+    assert _lookup(out, "gateway.ddeath_64.sigstop_to_ddeath.n") > 0
+    assert isinstance(_lookup(out, "gateway.ddeath_64.within_250_ms_pct"), int | float)
+    assert isinstance(_lookup(out, "gateway.ddeath_64.false_ddeaths"), int)
     assert _lookup(out, "gateway.simulators.one_process.cpu_pct_per_controller") is not None
     entries = {e["key"]: e for e in out["goals"]["entries"]}
     for key in GATEWAY_KEYS:
