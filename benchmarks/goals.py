@@ -116,6 +116,18 @@ GOALS: tuple[tuple[str, float | None, str, str], ...] = (
         "one dead of 16: the others' poll period p99 vs all alive",
     ),
     (
+        "gateway.ddeath_64.sigstop_to_ddeath.p99_ms",
+        250.0,
+        " ms",
+        "64 controllers at 10 Hz, 8 stopped by SIGSTOP: SIGSTOP -> DDEATH at the subscriber, p99",
+    ),
+    (
+        "gateway.ddeath_64.false_ddeaths",
+        0.0,
+        "",
+        "DDEATHs of controllers that were answering, in the same run",
+    ),
+    (
         "gateway.gateway_vs_bare.period_p99_ratio",
         None,
         "x",
