@@ -120,11 +120,15 @@ def test_a_refused_pause_is_pausing_until_the_controller_answers_then_paused(
     assert runs.pause_state is PauseState.NONE
 
 
-def test_the_words_of_a_pause_not_confirmed_in_chinese(qtbot: Any, translator: Any, planner: PlannerPanel) -> None:
+def test_the_words_of_a_pause_not_confirmed_in_chinese(
+    qtbot: Any, translator: Any, planner: PlannerPanel
+) -> None:
     flow = planner.run_flow
-    states = (PauseState.PAUSING, PauseState.UNCONFIRMED, PauseState.STOPPING, PauseState.PAUSED, PauseState.REFUSED)
+    states = tuple(state for state in PauseState if state is not PauseState.NONE)
     english = [flow.pause_text(state) for state in states]
-    assert english[4].startswith("Pause refused by the controller: the arm was not paused. Press STOP")
+    assert english[states.index(PauseState.REFUSED)].startswith(
+        "Pause refused by the controller: the arm was not paused. Press STOP"
+    )
     jog = JogPanel()
     qtbot.addWidget(jog)
     jog.show_halt(UnconfirmedHalt(HaltKind.PAUSE, 0.0, False))
