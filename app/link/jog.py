@@ -508,8 +508,11 @@ class JogMachine:
             return
         # each write waits the poll timeout at most: a controller that does not answer it gets it
         # again at the next poll, it does not hold the worker for the request timeout
+        now = time.monotonic()
+        halt.due(now)  # a Stop due now (escalated): the GUI hears it before the Stop's own results
+        self._publish_halt()
         with client.io_timeout(client.settings.effective_poll_timeout):
-            failure = settle(self._send, halt, time.monotonic())
+            failure = settle(self._send, halt, now)
         self._publish_halt()
         if failure is not None:
             raise failure

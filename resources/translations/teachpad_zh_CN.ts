@@ -3828,6 +3828,12 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <source>stopped by the operator</source>
             <translation>已由操作员停止</translation>
         </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="705" />
+            <source>the controller did not confirm the Pause in time: Stop was sent instead</source>
+            <extracomment>How many of the segments sent a run remembers (``sent_segments``): a run with endless loops sends segments for as long as it runs.</extracomment>
+            <translation>控制器未在时限内确认暂停：已改为发送停止</translation>
+        </message>
     </context>
     <context>
         <name>PlanRunFlow</name>

@@ -700,6 +700,12 @@ class PlanRunController(QObject):
         run ends *stopped by the operator* at it, never as a failure."""
         if not runner.stop_requested:
             runner.request_stop()
+        if self._pause_state is PauseState.STOPPING:  # the Pause, not confirmed in time, became a Stop
+            self.end_reason = self.tr(
+                "the controller did not confirm the Pause in time: Stop was sent instead"
+            )
+            self._by_operator = False
+            return
         self._mark_operator_stop()
 
     def _on_stop_failed(self, stop: Pending, error: WorkerError) -> None:

@@ -19,9 +19,11 @@ import pytest
 from pymodbus.constants import ExcCodes
 from PySide6.QtGui import QUndoStack
 
+from app import timing
 from app.errors import Reason
 from app.link.robot_link import RobotLink
 from app.link.types import HaltKind, UnconfirmedHalt
+from app.plan.runner import RunState
 from app.plan.segments import Plan, Segment
 from app.points.point import make_point
 from app.points.project_model import Project
@@ -152,3 +154,31 @@ def test_the_words_of_a_pause_not_confirmed_in_chinese(
     assert_chinese(jog.hold_label.toolTip())
     for reason in reasons:
         assert_chinese(reason_text(reason) or "")
+
+
+def test_a_pause_not_confirmed_in_time_stops_the_run_and_never_says_paused(
+    qtbot: Any, sim: Any, link: RobotLink, planner: PlannerPanel, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Busy past ``timing.PAUSE_ESCALATE_AFTER``: a Stop instead; the run ends stopped (resumable
+    from the segment), and the run box said "pausing", then the Stop, never "paused"."""
+    monkeypatch.setattr(timing, "PAUSE_ESCALATE_AFTER", 0.3)
+    runs = planner.run_controller
+    states: list[PauseState] = []
+    runs.pauseStateChanged.connect(states.append)
+    start = sim.state().pose
+    runs.start(planner.current_plan() or Plan("none", []))
+    qtbot.waitUntil(lambda: math.dist(sim.state().pose[:3], start[:3]) > 3.0, timeout=RUN_TIMEOUT_MS)
+    sim.set_exception(BUSY, range(registers.REG_PAUSE, registers.REG_PAUSE + 1), seconds=BUSY_FOR)
+    busy_until = time.monotonic() + BUSY_FOR
+    with qtbot.waitSignal(runs.runFinished, timeout=RUN_TIMEOUT_MS) as finished:
+        planner.planner_actions.all["pause"].trigger()
+    outcome = finished.args[0]
+    assert outcome.state is RunState.STOPPED and runs.can_resume, outcome
+    stops = sim.writes_to(registers.REG_STOP)
+    assert stops and stops[0].t < busy_until  # the Stop went out while the Pause was refused
+    assert not sim.state().moving and not sim.writes_to(registers.REG_PAUSE)
+    assert PauseState.STOPPING in states and PauseState.PAUSED not in states, states
+    text = planner.run_box.run_label.text()  # the run says why it stopped, never "paused"
+    assert text == (
+        "Stopped at segment 1: the controller did not confirm the Pause in time: Stop was sent instead"
+    ), text
