@@ -97,6 +97,7 @@ class JogMachine:
         self.halt: HaltWatch | None = None  # a jog / Stop being stopped, until the controller confirms
         self._shown: UnconfirmedHalt | None = None  # what the GUI was last told of it
         self._pause_requests: list[int | None] = []  # the Pause requests a PAUSE watch ends
+        self._program_state: int | None = None  # the last poll's program state (None: not read yet)
         self.guard: JogGuard | None = None  # the safety envelope's jog guard (immutable; set by the GUI)
         self.guard_timing = GuardTiming()  # the guard's look-ahead, measured (perf_counter clock)
         self._pose_read_at: float | None = None  # when the read of the poller's last pose was sent
@@ -160,6 +161,7 @@ class JogMachine:
     # --- sequences without urgent jobs in between (connect, close, idle) -------------------
     def make_teach_safe(self, status: ControllerStatus, ever_connected: bool) -> None:
         """On (re)connection: a jog left running by a lost link is stopped before anything else."""
+        self._program_state = int(status.program_state)  # (a Pause refused now: anything to pause?)
         client = self._host.client
         assert client is not None
         if not (ever_connected or status.mode == ControllerMode.MODBUS_TEACH):
@@ -191,6 +193,7 @@ class JogMachine:
 
     def after_status(self, status: ControllerStatus, now: float, *, idle: bool) -> None:
         """Per good poll: teach mode ended by the controller, or idle long enough to switch it off."""
+        self._program_state = int(status.program_state)
         self._pause_status(status)
         teach = self.teach
         if (
@@ -253,10 +256,14 @@ class JogMachine:
         """The operator's Pause (request ``request_id``) was refused or not answered: it is sent
         again at every poll until the controller answers it (or a Stop after
         :data:`app.timing.PAUSE_ESCALATE_AFTER` s); the request ends with the outcome. True: the
-        watch follows it. False: not a refusal it follows (the link failed), or a jog's stop or a
-        Stop is under way already (stronger than a Pause): the Pause fails as it is."""
+        watch follows it. False: not a refusal it follows (the link failed), nothing is under way
+        to pause (no motion of ours, and the last poll read the program stopped or paused), or a
+        jog's stop or a Stop is under way already (stronger than a Pause): the Pause fails as it is."""
         halt = self.halt
         if not halt_refusal(exc) or (halt is not None and halt.kind is not HaltKind.PAUSE):
+            return False
+        idle = self._program_state is not None and self._program_state != ProgramState.RUNNING
+        if halt is None and idle and self._tracker.motion_under_way is None:
             return False
         if halt is None:
             halt = self.halt = HaltWatch(HaltKind.PAUSE, None, time.monotonic())
