@@ -90,6 +90,12 @@ TRAFFIC_DELIVERY_PERIOD = 0.1
 HALT_ESCALATE_AFTER = 0.5
 # teachpad-cli keeps trying that long (s) before it gives up, says the arm may still move, exits 1.
 HALT_CONFIRM_BUDGET = 10.0
+# A Pause the controller refused or did not answer is sent again at every poll (app/link/halt.py);
+# not confirmed this long after the press (answered, or the program state reads paused), a Stop
+# goes out instead: the operator asked for the arm to halt, and a Pause is only the gentler way.
+# Longer than a jog's: a controller busy for a second or so (exception 6) still gets its Pause
+# (resumable), yet the arm never runs on for more than this against the operator's request.
+PAUSE_ESCALATE_AFTER = 2.0
 TEACH_IDLE_DISABLE = 30.0  # s after the last jog release before teach mode is disabled
 TEACH_MODE_GRACE = 0.3  # s after teach enable during which a status without mode 2 is not "teach lost"
 UPLOAD_CHUNK_POINTS = 20  # points per event-loop turn of an upload, at most ...

@@ -155,6 +155,31 @@ _TEMPLATES: dict[str, str] = {
     "stop_confirmed": QT_TRANSLATE_NOOP(
         "Messages", "Stop confirmed by the controller after {seconds} s; the arm stands still."
     ),
+    "pause_unconfirmed": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Pausing — the controller has not confirmed: it refused or did not answer the Pause; the arm "
+        "may still be moving. Pause is sent again at every poll. Press STOP if it must stop now.",
+    ),
+    "pause_escalated": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Pause not confirmed by the controller after {seconds} s: Stop is sent instead, at every poll, "
+        "until the controller takes it.",
+    ),
+    "pause_confirmed": QT_TRANSLATE_NOOP(
+        "Messages", "Pause confirmed by the controller after {seconds} s: the arm is paused."
+    ),
+    "pause_stopped": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Pause not confirmed by the controller within {seconds} s: the arm was stopped (Stop) instead.",
+    ),
+    "pause_nothing_running": QT_TRANSLATE_NOOP(
+        "Messages", "Pause: nothing left to pause (the motion ended before the controller took the Pause)."
+    ),
+    "pause_dropped": QT_TRANSLATE_NOOP(
+        "Messages",
+        "Pause not confirmed by the controller: it was not sent again (Resume, Stop, another motion or "
+        "a new connection came first).",
+    ),
     "halt_unconfirmed": QT_TRANSLATE_NOOP(
         "Messages",
         "{operation} refused: the controller has not confirmed that the arm stopped (the stop is "

@@ -244,6 +244,8 @@ def _confirm(client: RobotClient, halt: HaltWatch) -> None:
     def write(what: HaltWrite) -> None:
         if what is HaltWrite.SPEED_ZERO:
             client.teach_set_ratio(0.0)
+        elif what is HaltWrite.PAUSE:
+            client.pause()
         else:
             client.stop()
 
@@ -256,7 +258,9 @@ def _halt_failed(what: str, halt: HaltWatch) -> str:
 
 def _halt_confirmed(what: str, halt: HaltWatch) -> str:
     seconds = (halt.answered_at or time.monotonic()) - halt.since
-    answered = "stop (441)" if halt.answered_by is HaltWrite.STOP else "speed 0"
+    answered = {HaltWrite.STOP: "stop (441)", HaltWrite.PAUSE: "pause (442)"}.get(
+        halt.answered_by or HaltWrite.SPEED_ZERO, "speed 0"
+    )
     return (
         f"{what}: the controller refused or did not answer {halt.refusals} time(s) "
         f"({halt.last_error}); it took the {answered} after {seconds:.1f} s and the arm stands still"
@@ -403,10 +407,48 @@ def _stop_result(ok: bool, message: str, code: str) -> CommandResult:
 
 
 def cmd_pause(ctx: CliContext) -> ExitCode:
+    """442 until the controller answers it and the pose is seen still (app/link/halt.py): refused
+    or unanswered, sent again every ``JOG_POLL_INTERVAL``; not answered within
+    ``timing.PAUSE_ESCALATE_AFTER`` s, a Stop instead (exit 1: the arm was stopped, not paused);
+    nothing taken within ``timing.HALT_CONFIRM_BUDGET`` s: said, exit 1. Then the program state
+    is followed as before (paused, or nothing under way: the arm stands still)."""
+    client = ctx.client
+    halt = HaltWatch(HaltKind.PAUSE, None, time.monotonic())
+    with client.judged_writes() as judged:
+        _confirm(client, halt)
+    note = outcome_note(client.audit, judged)
+    if halt.given_up and halt.refusals == 1 and halt.last_error is not None:
+        raise halt.last_error  # refused for good (not busy): the controller's own words, at once
+    failure = _pause_failure(halt)
+    if failure is not None:
+        if note is not None:
+            note(CommandResult(None, None, None, False, str(failure), reason=failure.as_reason()))
+        raise failure
+    if halt.refusals:
+        ctx.warn(_halt_confirmed("pause", halt))
     # nothing under way (stopped) is what a pause wants too: the arm stands still
     paused = (ProgramState.PAUSED, ProgramState.STOPPED)
     check = StateCheck("pause", lambda s: s.program_state in paused, _state_words, 0.0)
-    return _judged(ctx, check, ctx.client.pause)
+    check.started = time.monotonic()
+    check.note = note
+    result = client.follow(check)
+    assert result is not None
+    return ctx.report(result.message)
+
+
+def _pause_failure(halt: HaltWatch) -> TeachPadError | None:
+    """The CLI's pause did not pause: not confirmed at all, or a Stop was taken instead."""
+    if not halt.over:
+        return TeachPadError(_halt_failed("pause", halt), code="halt_unconfirmed")
+    if halt.answered_by is HaltWrite.STOP:
+        seconds = (halt.answered_at or time.monotonic()) - halt.since
+        return TeachPadError(
+            f"pause: the controller did not take the pause within {seconds:.1f} s "
+            f"({halt.refusals} refused or unanswered: {halt.last_error}); Stop (441) was sent instead "
+            "and the arm stands still -- it was stopped, not paused",
+            code="pause_stopped",
+        )
+    return None
 
 
 def cmd_resume(ctx: CliContext) -> ExitCode:

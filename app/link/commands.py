@@ -12,7 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import Protocol
 
-from app.errors import ModbusExceptionError, Reason
+from app.errors import ModbusExceptionError, Reason, TeachPadError
 from app.link.client import RobotClient
 from app.link.jobs import Job
 from app.link.jog import JogMachine
@@ -39,6 +39,11 @@ __all__ = ["CommandsHost", "WorkerCommands"]
 class CommandsHost(Protocol):
     """What the short commands use of the worker (worker thread); the parts they drive (the
     jog, the motions, the upload) are given to :class:`WorkerCommands` one by one."""
+
+    @property
+    def request_id(self) -> int | None:
+        """The request id of the job being executed."""
+        ...
 
     def client_or_raise(self) -> RobotClient: ...
 
@@ -101,10 +106,21 @@ class WorkerCommands:
         self._done(ends, Operation.CANCEL_UPLOAD)
 
     def pause(self, _op: Pause) -> None:
-        self._host.client_or_raise().pause()
+        """442 <- 1. Refused or not answered: the Pause is followed (sent again at every poll,
+        app/link/halt.py) and this request ends when it is over: paused, stopped instead, or
+        nothing left to pause."""
+        client = self._host.client_or_raise()
+        try:
+            client.pause()
+        except TeachPadError as exc:
+            if not self._jog.pause_refused(exc, self._host.request_id):
+                raise
+            return
+        self._jog.pause_answered()
         self._done("pause: sent", Operation.PAUSE)
 
     def resume(self, _op: Resume) -> None:
+        self._jog.drop_pause("superseded by Resume")  # the operator no longer wants it
         self._host.client_or_raise().resume()
         self._done("resume: sent", Operation.RESUME)
 

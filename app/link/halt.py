@@ -34,6 +34,18 @@ answered") that lives here: **a jog is over only when the controller has answere
   the arm heading over a boundary;
 * the operator is told: the jog panel says "releasing -- the controller has not confirmed".
 
+**A Pause the controller refused or did not answer** (``HaltKind.PAUSE``; the same PROTOCOL.md
+decision): a Pause is over only when the controller has answered it (442 <- 1) -- or the program
+state reads paused -- or the motion is seen to have ended (the program state reads stopped and the
+pose is still). Until then it is sent again at every poll (a Pause is idempotent: a second one
+of a paused program changes nothing), the operator is told ("pausing -- the controller has not
+confirmed": press STOP if it must stop now), and no motion starts. It is not turned into a Stop
+at once (a Pause is meant to be resumed, and *busy* means "try again later"), but the operator
+asked for the arm to halt: not confirmed :data:`app.timing.PAUSE_ESCALATE_AFTER` s after the
+press (or refused for good: an exception other than 4, 5, 6), a Stop (441) goes out instead, at
+every poll until the controller takes it. The Pause's own request ends with the outcome: paused
+(confirmed after n s), stopped instead, or nothing left to pause.
+
 A Stop the controller refused is followed the same way (its own write, 441, from the start:
 :func:`follow_refused_stop`); a halt's Stop, once answered, ends the command in flight as the
 operator's does (:func:`write_halt_stop`). teachpad-cli gives up after :data:`app.timing.HALT_CONFIRM_BUDGET`
@@ -106,6 +118,7 @@ class HaltWrite(enum.Enum):
 
     SPEED_ZERO = "jog speed 0"  # GV203 <- 0: the jog stops, teach mode stays on
     STOP = "stop"  # 441 <- 1: everything stops
+    PAUSE = "pause"  # 442 <- 1: the program / move is held where it is (resumable)
 
 
 #: Modbus exceptions that mean "not now" (PROTOCOL.md section 7): 4 server device failure,
@@ -128,8 +141,9 @@ def _for_good(exc: TeachPadError) -> bool:
 
 
 class HaltWatch:
-    """One motion being stopped: a jog being released (``HaltKind.RELEASE``) or a Stop the
-    controller refused (``HaltKind.STOP``). See the module docstring.
+    """One motion being stopped: a jog being released (``HaltKind.RELEASE``), a Stop the
+    controller refused (``HaltKind.STOP``) or a Pause it refused (``HaltKind.PAUSE``). See the
+    module docstring.
 
     ``request``: the jog being released (the envelope guard keeps deciding on it); None when
     there was none (a Stop of a move or program).
@@ -147,7 +161,10 @@ class HaltWatch:
         self.request = request
         self.since = now
         self._clock_from = now  # the escalation's clock: from the release, or the controller's return
-        self.escalate_after = timing.HALT_ESCALATE_AFTER if escalate_after is None else escalate_after
+        if escalate_after is None:
+            pause = kind is HaltKind.PAUSE
+            escalate_after = timing.PAUSE_ESCALATE_AFTER if pause else timing.HALT_ESCALATE_AFTER
+        self.escalate_after = escalate_after
         self.escalated = kind is HaltKind.STOP  # a refused Stop: 441 is the write to repeat
         self.answered_at: float | None = None  # the controller answered a halting write
         self.answered_by: HaltWrite | None = None
@@ -159,6 +176,9 @@ class HaltWatch:
         self.over = False
         self._still_from: Pose | None = None  # the pose of the last poll after the answer
         self._moving_after_answer = False  # answered, and the pose still changed after that
+        self.program_paused = False  # a Pause's: the program state read paused (confirmed)
+        self._program_ended = False  # a Pause's: the program state read stopped (nothing to pause)
+        self._ended_at: Pose | None = None  # the pose of the last poll since it read stopped
 
     # -- what to send ------------------------------------------------------------------------
     @property
@@ -180,6 +200,8 @@ class HaltWatch:
             self.escalated = True
         if self.kind is HaltKind.STOP and self.request is None:
             writes: tuple[HaltWrite, ...] = (HaltWrite.STOP,)
+        elif self.kind is HaltKind.PAUSE:
+            writes = (HaltWrite.STOP,) if self.escalated else (HaltWrite.PAUSE,)
         elif self.escalated:
             writes = (HaltWrite.STOP, HaltWrite.SPEED_ZERO)
         else:
@@ -192,8 +214,15 @@ class HaltWatch:
         is nothing left to send (the arm may still move)."""
         if self.over or self.answered_at is not None:
             return False
-        needed = {HaltWrite.STOP} if self.kind is HaltKind.STOP and self.request is None else set(HaltWrite)
-        return needed <= self.refused_for_good
+        return self._needed() <= self.refused_for_good
+
+    def _needed(self) -> set[HaltWrite]:
+        """The writes that could stop this motion (each refused for good: nothing left to send)."""
+        if self.kind is HaltKind.PAUSE:
+            return {HaltWrite.PAUSE, HaltWrite.STOP}
+        if self.kind is HaltKind.STOP and self.request is None:
+            return {HaltWrite.STOP}
+        return {HaltWrite.SPEED_ZERO, HaltWrite.STOP}
 
     def answering_again(self, now: float) -> None:
         """The controller answers again after a silence: it gets the speed 0 first, and
@@ -231,10 +260,42 @@ class HaltWatch:
             self.refused_for_good.add(write)
             self.escalated = True
 
+    def program_seen(self, paused: bool, stopped: bool) -> bool:
+        """A Pause's watch, per poll: the program state read ``paused`` (the Pause is confirmed,
+        whoever's write did it: one that got no answer may have been carried out) or ``stopped``
+        (the motion ended: over once the pose is seen still). True once over."""
+        if self.kind is not HaltKind.PAUSE or self.over:
+            return self.over
+        if paused:  # held where it is (also once a Stop was due: the arm is halted, resumable)
+            self.program_paused = True
+            self.over = True
+        elif not stopped:
+            self._program_ended = False
+            self._ended_at = None
+        else:
+            self._program_ended = True
+        return self.over
+
+    def _ended_and_still(self, pose: Pose) -> bool:
+        """A Pause's watch: the program state reads stopped and the pose did not change since the
+        last poll (the motion ended before the Pause was taken)."""
+        if not self._program_ended:
+            return False
+        before, self._ended_at = self._ended_at, pose
+        return before is not None and not pose_moved(pose, before)
+
+    @property
+    def paused(self) -> bool:
+        """A Pause's watch that ended with the arm paused (answered, or read paused), not stopped."""
+        return self.over and (self.program_paused or self.answered_by is HaltWrite.PAUSE)
+
     def pose_seen(self, pose: Pose) -> bool:
         """A poll's pose; True once the halt is over (answered, then the pose unchanged from one
-        poll to the next)."""
+        poll to the next; a Pause's also: the program read stopped, and the pose unchanged)."""
         if self.over:
+            return True
+        if self.kind is HaltKind.PAUSE and self._ended_and_still(pose):
+            self.over = True
             return True
         if self.answered_at is None:
             self._still_from = None
@@ -256,11 +317,11 @@ class HaltWatch:
     def words(self, now: float) -> str:
         """The English sentence for logs and the CLI: what was tried and what came back."""
         seconds = f"{now - self.since:.1f}"
-        what = "the jog's speed 0" if self.kind is HaltKind.RELEASE else "the stop"
+        what = {HaltKind.RELEASE: "the jog's speed 0", HaltKind.STOP: "the stop", HaltKind.PAUSE: "the pause"}
         cause = f": {self.last_error}" if self.last_error is not None else ""
-        stop = " and Stop (441)" if self.escalated and self.kind is HaltKind.RELEASE else ""
+        stop = " and Stop (441)" if self.escalated and self.kind is not HaltKind.STOP else ""
         return (
-            f"the controller did not confirm {what}{stop} within {seconds} s "
+            f"the controller did not confirm {what[self.kind]}{stop} within {seconds} s "
             f"({self.refusals} refused or unanswered{cause})"
         )
 

@@ -10,7 +10,9 @@ A jog is over only when the controller has answered its speed 0 (or a Stop) and 
 seen still (:class:`~app.link.halt.HaltWatch`, app/link/halt.py): a refused or unanswered speed 0
 is sent again at every poll (:meth:`JogMachine.settle_halt`), escalates to Stop, the envelope
 guard keeps deciding on the jog being released, and the GUI is told (``publish_halt``). A Stop
-the controller refused is followed the same way. No new jog or motion starts meanwhile.
+the controller refused is followed the same way, and so is a Pause it refused
+(:meth:`JogMachine.pause_refused`; the Pause's request ends with the outcome). No new jog or
+motion starts meanwhile.
 """
 
 from __future__ import annotations
@@ -37,12 +39,19 @@ from app.link.outcome import UNKNOWN_ADVICE
 from app.link.tracker import CommandTracker
 from app.link.types import HaltKind, JogRequest, Operation, UnconfirmedHalt
 from app.models import CommandResult, ControllerStatus, Pose
-from app.protocol.enums import ControllerMode, TeachFrame, controller_mode_text
+from app.protocol.enums import ControllerMode, ProgramState, TeachFrame, controller_mode_text
 from app.protocol.exceptions import exception_text, not_carried_out
 from app.safety.envelope import EnvelopeRefused, EnvelopeViolation
 from app.safety.jog_guard import GuardTiming, JogGuard
 
 __all__ = ["JogMachine", "PreemptedError", "TeachState"]
+
+#: The operation a halt's unconfirmed / escalated notice is said under.
+_HALT_OPERATION = {
+    HaltKind.RELEASE: Operation.JOG_RELEASE,
+    HaltKind.STOP: Operation.STOP,
+    HaltKind.PAUSE: Operation.PAUSE,
+}
 
 
 @dataclass
@@ -87,6 +96,8 @@ class JogMachine:
         self.released_at = 0.0
         self.halt: HaltWatch | None = None  # a jog / Stop being stopped, until the controller confirms
         self._shown: UnconfirmedHalt | None = None  # what the GUI was last told of it
+        self._pause_requests: list[int | None] = []  # the Pause requests a PAUSE watch ends
+        self._program_state: int | None = None  # the last poll's program state (None: not read yet)
         self.guard: JogGuard | None = None  # the safety envelope's jog guard (immutable; set by the GUI)
         self.guard_timing = GuardTiming()  # the guard's look-ahead, measured (perf_counter clock)
         self._pose_read_at: float | None = None  # when the read of the poller's last pose was sent
@@ -106,7 +117,7 @@ class JogMachine:
         """A new connection (new settings): nothing is known about teach mode."""
         self.teach = TeachState()
         self.teach_dirty = False
-        self._drop_halt()
+        self._drop_halt("the connection was made again")
 
     def end_jog(self) -> None:
         """Forget the held jog; a jog sequence still running for it gives way."""
@@ -150,6 +161,7 @@ class JogMachine:
     # --- sequences without urgent jobs in between (connect, close, idle) -------------------
     def make_teach_safe(self, status: ControllerStatus, ever_connected: bool) -> None:
         """On (re)connection: a jog left running by a lost link is stopped before anything else."""
+        self._program_state = int(status.program_state)  # (a Pause refused now: anything to pause?)
         client = self._host.client
         assert client is not None
         if not (ever_connected or status.mode == ControllerMode.MODBUS_TEACH):
@@ -181,6 +193,8 @@ class JogMachine:
 
     def after_status(self, status: ControllerStatus, now: float, *, idle: bool) -> None:
         """Per good poll: teach mode ended by the controller, or idle long enough to switch it off."""
+        self._program_state = int(status.program_state)
+        self._pause_status(status)
         teach = self.teach
         if (
             teach.enabled
@@ -233,8 +247,83 @@ class JogMachine:
             if jog is not None or self.teach.moving:
                 self.teach_dirty = True  # the link failed: speed 0 and teach off on its return
             return
+        self._end_pause_requests("superseded by the Stop, which is sent again at every poll")
         self.halt = follow_refused_stop(self.halt, jog, exc, time.monotonic())
         self._publish_halt()
+
+    # --- a Pause until the controller confirms it (app/link/halt.py) ----------------------
+    def pause_refused(self, exc: TeachPadError, request_id: int | None) -> bool:
+        """The operator's Pause (request ``request_id``) was refused or not answered: it is sent
+        again at every poll until the controller answers it (or a Stop after
+        :data:`app.timing.PAUSE_ESCALATE_AFTER` s); the request ends with the outcome. True: the
+        watch follows it. False: not a refusal it follows (the link failed), nothing is under way
+        to pause (no motion of ours, and the last poll read the program stopped or paused), or a
+        jog's stop or a Stop is under way already (stronger than a Pause): the Pause fails as it is."""
+        halt = self.halt
+        if not halt_refusal(exc) or (halt is not None and halt.kind is not HaltKind.PAUSE):
+            return False
+        idle = self._program_state is not None and self._program_state != ProgramState.RUNNING
+        if halt is None and idle and self._tracker.motion_under_way is None:
+            return False
+        if halt is None:
+            halt = self.halt = HaltWatch(HaltKind.PAUSE, None, time.monotonic())
+        halt.refused(HaltWrite.PAUSE, exc)
+        self._pause_requests.append(request_id)
+        self._publish_halt()
+        return True
+
+    def pause_answered(self) -> None:
+        """The controller answered a Pause: a Pause being followed is answered too."""
+        halt = self.halt
+        if halt is not None and halt.kind is HaltKind.PAUSE:
+            halt.took(HaltWrite.PAUSE, time.monotonic())
+
+    def drop_pause(self, why: str) -> None:
+        """A Pause being followed is dropped (the operator resumed): not sent again."""
+        if self.halt is not None and self.halt.kind is HaltKind.PAUSE:
+            self._drop_halt(why)
+
+    def _pause_status(self, status: ControllerStatus) -> None:
+        """Per good poll: a Pause being followed is confirmed by the program state reading
+        paused, or ends once it reads stopped and the pose is still (nothing left to pause)."""
+        halt = self.halt
+        if halt is None or halt.kind is not HaltKind.PAUSE:
+            return
+        state = status.program_state
+        if halt.program_seen(state == ProgramState.PAUSED, state == ProgramState.STOPPED):
+            self._halt_over(halt)
+
+    def _pause_over(self, halt: HaltWatch) -> None:
+        """A Pause's watch is over: each of its requests ends with what happened."""
+        seconds = round(time.monotonic() - halt.since, 1)
+        args: dict[str, object] = {"seconds": seconds}
+        if halt.paused:
+            ok, code = True, "pause_confirmed"
+            text = f"pause: confirmed by the controller after {seconds:.1f} s (the arm is paused)"
+        elif halt.answered_by is HaltWrite.STOP:
+            ok, code = False, "pause_stopped"
+            text = (
+                f"pause: not confirmed by the controller within {seconds:.1f} s: Stop was sent instead "
+                "and the arm stands still"
+            )
+        else:
+            ok, code = True, "pause_nothing_running"
+            text = "pause: nothing left to pause (the motion ended before the controller took the pause)"
+        self._emit_pause_requests(CommandResult(None, None, None, ok, text, reason=Reason(code, args)))
+
+    def _end_pause_requests(self, why: str) -> None:
+        """A Pause's watch ends unconfirmed (dropped or superseded): its requests fail, saying why."""
+        halt = self.halt
+        if halt is None or halt.kind is not HaltKind.PAUSE:
+            return
+        text = f"pause: not confirmed by the controller ({why})"
+        reason = Reason("pause_dropped", {"why": why})
+        self._emit_pause_requests(CommandResult(None, None, None, False, text, reason=reason))
+
+    def _emit_pause_requests(self, result: CommandResult) -> None:
+        requests, self._pause_requests = self._pause_requests, []
+        for request_id in requests:
+            self._host.emit_result(result, request_id)
 
     # --- jobs ----------------------------------------------------------------------------
     def _check(self, serial: int) -> None:
@@ -265,7 +354,7 @@ class JogMachine:
             )
         self.require_no_halt(Operation.JOG)
         self._require_guard(request)  # refused before teach mode is even switched on
-        self._drop_halt()  # a release answered, not seen still yet: this jog supersedes it
+        self._drop_halt("superseded by a jog")  # a release answered, not seen still yet: superseded
         self.jog = request
         self._serial += 1
         serial = self._serial
@@ -404,7 +493,11 @@ class JogMachine:
         """Refuse ``operation`` while a jog's stop or a Stop is not confirmed by the controller."""
         halt = self.halt
         if halt is not None and halt.unconfirmed:
-            what = "the last jog's stop" if halt.kind is HaltKind.RELEASE else "the Stop"
+            what = {
+                HaltKind.RELEASE: "the last jog's stop",
+                HaltKind.STOP: "the Stop",
+                HaltKind.PAUSE: "the Pause",
+            }[halt.kind]
             raise TeachPadError(
                 f"{operation} refused: the controller has not confirmed {what} yet (it is sent again "
                 "at every poll; press Stop, or wait until the arm is seen still)",
@@ -422,8 +515,11 @@ class JogMachine:
             return
         # each write waits the poll timeout at most: a controller that does not answer it gets it
         # again at the next poll, it does not hold the worker for the request timeout
+        now = time.monotonic()
+        halt.due(now)  # a Stop due now (escalated): the GUI hears it before the Stop's own results
+        self._publish_halt()
         with client.io_timeout(client.settings.effective_poll_timeout):
-            failure = settle(self._send, halt, time.monotonic())
+            failure = settle(self._send, halt, now)
         self._publish_halt()
         if failure is not None:
             raise failure
@@ -433,7 +529,15 @@ class JogMachine:
         halt = self.halt
         if halt is None or not halt.pose_seen(pose):
             return
+        self._halt_over(halt)
+
+    def _halt_over(self, halt: HaltWatch) -> None:
+        """The halt is over: forgotten, and the operator told if they were told it went wrong."""
         self.halt = None
+        if halt.kind is HaltKind.PAUSE:
+            self._pause_over(halt)  # its requests say it (the GUI's Pause waits for them)
+            self._publish_halt()
+            return
         if not halt.speed_zero_answered and self.teach.moving:
             # stopped by a Stop while GV203 still holds the jog's speed: teach mode counts as
             # unknown, so the next jog writes speed 0 and switches teach off and on first
@@ -469,7 +573,8 @@ class JogMachine:
         self._begin_halt(kind, request)
         self.settle_halt()
 
-    def _drop_halt(self) -> None:
+    def _drop_halt(self, why: str = "superseded") -> None:
+        self._end_pause_requests(why)
         self.halt = None
         self._publish_halt()
 
@@ -491,6 +596,10 @@ class JogMachine:
         client = self._host.client
         if client is None:
             raise LinkError("not connected to a controller", code="not_connected")
+        if write is HaltWrite.PAUSE:
+            client.pause()
+            self.pause_answered()
+            return
         write_halt_stop(client, self.halt, self._tracker, self._host.emit_result)
 
     def _publish_halt(self, *, quiet: bool = False) -> None:
@@ -504,11 +613,12 @@ class JogMachine:
         if state is None or halt is None or quiet:
             return
         now = time.monotonic()
-        release = halt.kind is HaltKind.RELEASE
-        if before is None or (release and state.escalated and not before.escalated):
-            # release_unconfirmed, release_escalated (Stop sent too), stop_unconfirmed
-            step = "escalated" if release and state.escalated else "unconfirmed"
-            operation = Operation.JOG_RELEASE if release else Operation.STOP
+        goes_on = halt.kind is not HaltKind.STOP  # a release or a Pause: a Stop may follow
+        if before is None or (goes_on and state.escalated and not before.escalated):
+            # release_unconfirmed, release_escalated (Stop sent too), stop_unconfirmed,
+            # pause_unconfirmed, pause_escalated (Stop sent instead)
+            step = "escalated" if goes_on and state.escalated else "unconfirmed"
+            operation = _HALT_OPERATION[halt.kind]
             reason = Reason(f"{halt.kind.value}_{step}", {"seconds": round(now - halt.since, 1)})
             self._host.emit_error(operation, halt.words(now), None, reason)
 
@@ -551,7 +661,8 @@ class JogMachine:
             or (last_status is not None and last_status.mode == ControllerMode.MODBUS_TEACH)
         ):
             return
-        self._drop_halt()  # the motion's own commands take over (a halt not confirmed refused it before)
+        # the motion's own commands take over (a halt not confirmed refused it before)
+        self._drop_halt("superseded by a motion")
         self.end_jog()
         self._speed_zero()
         self.disable_teach()

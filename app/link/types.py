@@ -175,6 +175,7 @@ class HaltKind(enum.Enum):
 
     RELEASE = "release"  # a jog the operator let go of: speed 0
     STOP = "stop"  # the operator's Stop (441)
+    PAUSE = "pause"  # the operator's Pause (442), refused or unanswered: sent again until answered
 
 
 @dataclass(frozen=True)

@@ -1696,61 +1696,71 @@ The pendant connects to it and commands it; every other robot of the cell stays 
         </message>
         <message>
             <location filename="../../ui/panels/jog_panel.py" line="375" />
+            <source>Pausing — the controller has not confirmed; press STOP</source>
+            <translation>正在暂停 — 控制器尚未确认；请按停止</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/jog_panel.py" line="377" />
             <source>Stopping — the controller has not confirmed</source>
             <translation>正在停止 — 控制器尚未确认</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="377" />
+            <location filename="../../ui/panels/jog_panel.py" line="379" />
             <source>The controller refused or did not answer the write that stops the arm. TeachPad sends it again at every poll until the controller answers and the arm is seen still.</source>
             <translation>控制器拒绝或未应答使机械臂停止的写入。TeachPad 每次轮询都会重新发送，直到控制器应答且确认机械臂已静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="381" />
+            <location filename="../../ui/panels/jog_panel.py" line="384" />
+            <source>The Pause was not confirmed in time: Stop was sent instead.</source>
+            <translation>暂停未在时限内得到确认：已改为发送停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/jog_panel.py" line="386" />
             <source>Stop was sent too.</source>
             <translation>也已发送停止命令。</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="521" />
+            <location filename="../../ui/panels/jog_panel.py" line="527" />
             <source>°</source>
             <translation>°</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="521" />
+            <location filename="../../ui/panels/jog_panel.py" line="527" />
             <source>mm</source>
             <translation>mm</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="523" />
+            <location filename="../../ui/panels/jog_panel.py" line="529" />
             <source>Hold: {axis} − ({unit})</source>
             <translation>按住：{axis} −（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="526" />
+            <location filename="../../ui/panels/jog_panel.py" line="532" />
             <source>Hold: {axis} + ({unit})</source>
             <translation>按住：{axis} +（{unit}）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="540" />
+            <location filename="../../ui/panels/jog_panel.py" line="546" />
             <source>{ratio} %</source>
             <translation>{ratio} %</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="545" />
+            <location filename="../../ui/panels/jog_panel.py" line="551" />
             <source>{ratio} % → {cap} % (reduced speed)</source>
             <translation>{ratio} % → {cap} %（降速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="547" />
+            <location filename="../../ui/panels/jog_panel.py" line="553" />
             <source>{ratio} % → {cap} %</source>
             <translation>{ratio} % → {cap} %</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="552" />
+            <location filename="../../ui/panels/jog_panel.py" line="558" />
             <source>Capped at {cap} % (reduced speed): the jog goes out at {cap} %, not {ratio} %</source>
             <translation>限制为 {cap} %（降速模式）：点动以 {cap} % 而不是 {ratio} % 发出</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/jog_panel.py" line="555" />
+            <location filename="../../ui/panels/jog_panel.py" line="561" />
             <source>Capped at {cap} % (the safety envelope's maximum): the jog goes out at {cap} %, not {ratio} %</source>
             <translation>限制为 {cap} %（安全范围的最大值）：点动以 {cap} % 而不是 {ratio} % 发出</translation>
         </message>
@@ -2240,207 +2250,237 @@ The pendant connects to it and commands it; every other robot of the cell stays 
         </message>
         <message>
             <location filename="../../ui/messages.py" line="158" />
+            <source>Pausing — the controller has not confirmed: it refused or did not answer the Pause; the arm may still be moving. Pause is sent again at every poll. Press STOP if it must stop now.</source>
+            <translation>正在暂停 — 控制器尚未确认：它拒绝或未应答暂停；机械臂可能仍在运动。每次轮询都会重新发送暂停。如需立即停止，请按停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="163" />
+            <source>Pause not confirmed by the controller after {seconds} s: Stop is sent instead, at every poll, until the controller takes it.</source>
+            <translation>{seconds} 秒后控制器仍未确认暂停：改为在每次轮询时发送停止，直到控制器接受。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="168" />
+            <source>Pause confirmed by the controller after {seconds} s: the arm is paused.</source>
+            <translation>控制器在 {seconds} 秒后确认了暂停：机械臂已暂停。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="171" />
+            <source>Pause not confirmed by the controller within {seconds} s: the arm was stopped (Stop) instead.</source>
+            <translation>控制器在 {seconds} 秒内未确认暂停：已改为停止机械臂。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="175" />
+            <source>Pause: nothing left to pause (the motion ended before the controller took the Pause).</source>
+            <translation>暂停：没有可暂停的运动（运动在控制器接受暂停之前已结束）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="178" />
+            <source>Pause not confirmed by the controller: it was not sent again (Resume, Stop, another motion or a new connection came first).</source>
+            <translation>控制器未确认暂停：不再重新发送（之前已有继续、停止、其他运动或新的连接）。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/messages.py" line="183" />
             <source>{operation} refused: the controller has not confirmed that the arm stopped (the stop is sent again at every poll). Press Stop, or wait until the arm stands still.</source>
             <translation>{operation}被拒绝：控制器尚未确认机械臂已停止（每次轮询都会重新发送停止）。请按停止，或等待机械臂静止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="163" />
+            <location filename="../../ui/messages.py" line="188" />
             <source>The controller is not answering: the plan was not started. Try again when it answers.</source>
             <translation>控制器无应答：计划未启动。待其恢复应答后再试。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="166" />
+            <location filename="../../ui/messages.py" line="191" />
             <source>Jog speed {value}% is not within 1..100%.</source>
             <translation>点动速度 {value}% 不在 1..100% 范围内。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="168" />
+            <location filename="../../ui/messages.py" line="193" />
             <source>Lost the connection to the controller at {endpoint}.</source>
             <translation>与控制器 {endpoint} 的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="169" />
+            <location filename="../../ui/messages.py" line="194" />
             <source>The controller at {endpoint} closed the connection.</source>
             <translation>控制器 {endpoint} 关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="170" />
+            <location filename="../../ui/messages.py" line="195" />
             <source>The host name {host} cannot be resolved.</source>
             <translation>无法解析主机名 {host}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="171" />
+            <location filename="../../ui/messages.py" line="196" />
             <source>The host name {host} is not valid: check it in Connect…</source>
             <translation>主机名 {host} 无效：请在“连接…”中检查。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="172" />
+            <location filename="../../ui/messages.py" line="197" />
             <source>Connection refused: nothing listens on port {port}.</source>
             <translation>连接被拒绝：端口 {port} 上没有服务在监听。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="175" />
+            <location filename="../../ui/messages.py" line="200" />
             <source>No answer to the connection request within {seconds} s.</source>
             <translation>连接请求在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="178" />
+            <location filename="../../ui/messages.py" line="203" />
             <source>The connection could not be opened.</source>
             <translation>无法建立连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="179" />
+            <location filename="../../ui/messages.py" line="204" />
             <source>Cannot open the serial port {port}.</source>
             <translation>无法打开串口 {port}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="180" />
+            <location filename="../../ui/messages.py" line="205" />
             <source>The controller at {endpoint} did not answer within {seconds} s.</source>
             <translation>控制器 {endpoint} 在 {seconds} s 内无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="183" />
+            <location filename="../../ui/messages.py" line="208" />
             <source>Malformed answer from the controller at {endpoint}: {field} expected {expected}, got {got}.</source>
             <translation>控制器 {endpoint} 的应答格式错误：{field}应为 {expected}，实际为 {got}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="187" />
+            <location filename="../../ui/messages.py" line="212" />
             <source>The controller refused the request: Modbus exception {exception} ({name}).</source>
             <translation>控制器拒绝了请求：Modbus 异常 {exception}（{name}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="192" />
+            <location filename="../../ui/messages.py" line="217" />
             <source>Pause refused by the controller (Modbus exception {exception}, {name}): the arm was not paused. Press STOP if it must stop now, or press Pause again.</source>
             <translation>控制器拒绝了暂停（Modbus 异常 {exception}，{name}）：机械臂没有暂停。如需立即停止请按停止，或再按一次暂停。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="197" />
+            <location filename="../../ui/messages.py" line="222" />
             <source>Resume refused by the controller (Modbus exception {exception}, {name}): the arm stays paused. Press Resume again in a moment.</source>
             <translation>控制器拒绝了继续（Modbus 异常 {exception}，{name}）：机械臂仍处于暂停。请稍后再按一次继续。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="202" />
+            <location filename="../../ui/messages.py" line="227" />
             <source>Switch to {mode} mode refused by the controller (Modbus exception {exception}, {name}): the work mode did not change. Switch it again in a moment.</source>
             <translation>控制器拒绝了切换到{mode}模式（Modbus 异常 {exception}，{name}）：工作模式没有改变。请稍后再切换一次。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="207" />
+            <location filename="../../ui/messages.py" line="232" />
             <source>{command} refused by the controller: Modbus exception {exception} ({name}).</source>
             <translation>控制器拒绝了{command}：Modbus 异常 {exception}（{name}）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="211" />
+            <location filename="../../ui/messages.py" line="236" />
             <source>No device answered at unit id {unit} (Modbus exception {exception}, {name}): check the unit id in Connect…</source>
             <translation>从站地址 {unit} 上没有设备应答（Modbus 异常 {exception}，{name}）：请在“连接…”中检查从站地址。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="215" />
+            <location filename="../../ui/messages.py" line="240" />
             <source>Monitor-only mode: nothing was sent to the controller.</source>
             <translation>仅监视模式：未向控制器发送任何内容。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="216" />
+            <location filename="../../ui/messages.py" line="241" />
             <source>Not sent: the audit trail in {folder} cannot be written ({cause}). No write goes out without its record (Stop still does): free disk space or fix the audit folder.</source>
             <translation>未发送：审计记录目录 {folder} 无法写入（{cause}）。没有审计记录的写入一律不发送（停止除外）：请释放磁盘空间或修复审计目录。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="221" />
+            <location filename="../../ui/messages.py" line="246" />
             <source>{operation}: not sent, the controller is in {mode} mode. Switching it to auto is the operator's decision: say yes when the confirmation asks, or switch it to auto first.</source>
             <translation>{operation}：未发送，控制器处于{mode}模式。切换到自动模式须由操作员决定：在确认框询问时选择“是”，或先将其切换到自动模式。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="226" />
+            <location filename="../../ui/messages.py" line="251" />
             <source>{operation}: not sent in reduced-speed mode: it runs at the controller's own speed, which TeachPad cannot cap.</source>
             <translation>{operation}：降速模式下未发送：它以控制器自身的速度运行，TeachPad 无法限制该速度。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="231" />
+            <location filename="../../ui/messages.py" line="256" />
             <location filename="../../ui/messages_plan.py" line="29" />
             <source>Invalid value: nothing was sent.</source>
             <translation>数值无效：未发送。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="232" />
+            <location filename="../../ui/messages.py" line="257" />
             <source>Unexpected internal error; the log has the details.</source>
             <translation>意外的内部错误；详情见日志。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="234" />
+            <location filename="../../ui/messages.py" line="259" />
             <source>The arm stopped at ({got}), {distance} mm from {point} ({want}): the controller's copy of the point is not this project's (overwritten by another tool?). Check the point and the robot before resuming.</source>
             <translation>机械臂停在 ({got})，距 {point} ({want}) {distance} mm：控制器中的该点与本项目不一致（被其他工具改写？）。恢复运行前请检查该点和机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="238" />
+            <location filename="../../ui/messages.py" line="263" />
             <source>The controller did not create {point} again before the move: the arm was not moved.</source>
             <translation>运动前控制器未能重新创建 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="241" />
+            <location filename="../../ui/messages.py" line="266" />
             <source>The project has no point {point}: the arm was not moved.</source>
             <translation>项目中没有点 {point}：机械臂未移动。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="244" />
+            <location filename="../../ui/messages.py" line="269" />
             <source>The arm's position after the move to {point} is not known: the run is stopped.</source>
             <translation>移动到 {point} 后机械臂的位置未知：运行已停止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="248" />
+            <location filename="../../ui/messages.py" line="273" />
             <source>The link was shut down.</source>
             <translation>通信链路已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="258" />
+            <location filename="../../ui/messages.py" line="283" />
             <source>{operation}: not sent, the connection to the controller is down.</source>
             <translation>{operation}：未发送，与控制器的连接已断开。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="261" />
+            <location filename="../../ui/messages.py" line="286" />
             <source>{operation}: not sent, the connection was closed.</source>
             <translation>{operation}：未发送，连接已关闭。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="263" />
+            <location filename="../../ui/messages.py" line="288" />
             <source>points outside {id_min}..{id_max}: {ids}</source>
             <translation>超出 {id_min}..{id_max} 范围的点：{ids}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="264" />
+            <location filename="../../ui/messages.py" line="289" />
             <source>there is no point P{id}</source>
             <translation>不存在点 P{id}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="265" />
+            <location filename="../../ui/messages.py" line="290" />
             <source>no free point id left in {start}..{id_max}</source>
             <translation>{start}..{id_max} 范围内已没有空闲的点编号</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="266" />
+            <location filename="../../ui/messages.py" line="291" />
             <source>there is no row {row}</source>
             <translation>不存在第 {row} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="267" />
+            <location filename="../../ui/messages.py" line="292" />
             <source>cannot move row {src} to {dst} in {rows} rows</source>
             <translation>无法在 {rows} 行中将第 {src} 行移到第 {dst} 行</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="268" />
+            <location filename="../../ui/messages.py" line="293" />
             <source>row {row}: id {id} is already used on row {other}</source>
             <translation>第 {row} 行：编号 {id} 已被第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="269" />
+            <location filename="../../ui/messages.py" line="294" />
             <source>imported point {number}: id {id} appears twice</source>
             <translation>导入的第 {number} 个点：编号 {id} 出现了两次</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="270" />
+            <location filename="../../ui/messages.py" line="295" />
             <source>id {id} is already used by {point}</source>
             <translation>编号 {id} 已被 {point} 使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="271" />
+            <location filename="../../ui/messages.py" line="296" />
             <source>the file has no points: replacing with it would remove all {existing} points of the project (merge it, or ask explicitly for an empty import)</source>
             <translation>文件中没有点：用它替换将删除工程中全部 {existing} 个点（请改用合并，或明确要求空导入）</translation>
         </message>
@@ -2540,398 +2580,398 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>编号 {id} 已在第 {other} 行使用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="249" />
+            <location filename="../../ui/messages.py" line="274" />
             <source>{operation}: the connection was lost while it was under way; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{operation}：执行期间连接中断，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="253" />
+            <location filename="../../ui/messages.py" line="278" />
             <source>{operation}: the connection was closed while it was under way; the outcome is unknown — check the robot before sending it again.</source>
             <translation>{operation}：执行期间连接被关闭，结果未知——再次发送前请先检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="282" />
+            <location filename="../../ui/messages.py" line="307" />
             <source>No connection to the controller.</source>
             <translation>未连接控制器。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="283" />
+            <location filename="../../ui/messages.py" line="308" />
             <source>The controller closed the connection.</source>
             <translation>控制器关闭了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="284" />
+            <location filename="../../ui/messages.py" line="309" />
             <source>Connection refused by the controller.</source>
             <translation>控制器拒绝了连接。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="285" />
+            <location filename="../../ui/messages.py" line="310" />
             <source>The controller did not answer.</source>
             <translation>控制器无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="286" />
+            <location filename="../../ui/messages.py" line="311" />
             <source>Malformed answer from the controller.</source>
             <translation>控制器的应答格式错误。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="287" />
+            <location filename="../../ui/messages.py" line="312" />
             <source>Cannot open the serial port.</source>
             <translation>无法打开串口。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="288" />
+            <location filename="../../ui/messages.py" line="313" />
             <source>The host name cannot be resolved.</source>
             <translation>无法解析主机名。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="289" />
+            <location filename="../../ui/messages.py" line="314" />
             <source>The host name is not valid.</source>
             <translation>主机名无效。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="290" />
+            <location filename="../../ui/messages.py" line="315" />
             <source>No answer to the connection request.</source>
             <translation>连接请求无应答。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="291" />
+            <location filename="../../ui/messages.py" line="316" />
             <source>{command} did not finish in time.</source>
             <translation>{command}未按时完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="292" />
+            <location filename="../../ui/messages.py" line="317" />
             <source>{command}: the controller did not acknowledge it.</source>
             <translation>{command}：控制器未确认。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="293" />
+            <location filename="../../ui/messages.py" line="318" />
             <source>{command} ended by an alarm.</source>
             <translation>{command}因报警而中止。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="294" />
-            <location filename="../../ui/messages.py" line="314" />
+            <location filename="../../ui/messages.py" line="319" />
+            <location filename="../../ui/messages.py" line="339" />
             <source>{command} refused by the controller.</source>
             <translation>控制器拒绝了{command}。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="295" />
+            <location filename="../../ui/messages.py" line="320" />
             <source>{command}: done.</source>
             <translation>{command}：已完成。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="296" />
+            <location filename="../../ui/messages.py" line="321" />
             <source>The controller refused the request (Modbus exception).</source>
             <translation>控制器拒绝了请求（Modbus 异常）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="299" />
+            <location filename="../../ui/messages.py" line="324" />
             <source>{operation}: not sent, the controller is not in auto mode.</source>
             <translation>{operation}：未发送，控制器不处于自动模式。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="302" />
+            <location filename="../../ui/messages.py" line="327" />
             <source>Pause refused by the controller: the arm was not paused. Press STOP if it must stop now, or press Pause again.</source>
             <translation>控制器拒绝了暂停：机械臂没有暂停。如需立即停止请按停止，或再按一次暂停。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="307" />
+            <location filename="../../ui/messages.py" line="332" />
             <source>Resume refused by the controller: the arm stays paused. Press Resume again in a moment.</source>
             <translation>控制器拒绝了继续：机械臂仍处于暂停。请稍后再按一次继续。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="310" />
+            <location filename="../../ui/messages.py" line="335" />
             <source>Work mode change refused by the controller: the work mode did not change. Switch it again in a moment.</source>
             <translation>控制器拒绝了工作模式切换：工作模式没有改变。请稍后再切换一次。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="321" />
+            <location filename="../../ui/messages.py" line="346" />
             <source>Cannot reconnect to the controller at {endpoint}: {cause}</source>
             <translation>无法重新连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="322" />
+            <location filename="../../ui/messages.py" line="347" />
             <source>Cannot connect to the controller at {endpoint}: {cause}</source>
             <translation>无法连接控制器 {endpoint}：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="323" />
+            <location filename="../../ui/messages.py" line="348" />
             <source>The command</source>
             <translation>该命令</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="324" />
+            <location filename="../../ui/messages.py" line="349" />
             <source>Failed.</source>
             <translation>失败。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="325" />
+            <location filename="../../ui/messages.py" line="350" />
             <source>Failed: {message}</source>
             <translation>失败：{message}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="328" />
+            <location filename="../../ui/messages.py" line="353" />
             <source>stop</source>
             <translation>停止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="329" />
+            <location filename="../../ui/messages.py" line="354" />
             <source>pause</source>
             <translation>暂停</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="330" />
+            <location filename="../../ui/messages.py" line="355" />
             <source>resume</source>
             <translation>继续</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="331" />
+            <location filename="../../ui/messages.py" line="356" />
             <source>jog</source>
             <translation>点动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="332" />
+            <location filename="../../ui/messages.py" line="357" />
             <source>jog release</source>
             <translation>点动松开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="333" />
+            <location filename="../../ui/messages.py" line="358" />
             <source>jog speed</source>
             <translation>点动速度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="334" />
+            <location filename="../../ui/messages.py" line="359" />
             <source>incremental move</source>
             <translation>增量运动</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="335" />
+            <location filename="../../ui/messages.py" line="360" />
             <source>work mode</source>
             <translation>工作模式</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="336" />
+            <location filename="../../ui/messages.py" line="361" />
             <source>go to zero</source>
             <translation>回零</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="337" />
+            <location filename="../../ui/messages.py" line="362" />
             <source>run program</source>
             <translation>运行程序</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="338" />
+            <location filename="../../ui/messages.py" line="363" />
             <source>create temp point</source>
             <translation>创建临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="339" />
+            <location filename="../../ui/messages.py" line="364" />
             <source>move to temp point</source>
             <translation>运动至临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="340" />
+            <location filename="../../ui/messages.py" line="365" />
             <source>upload temp points</source>
             <translation>上传临时点</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="341" />
+            <location filename="../../ui/messages.py" line="366" />
             <source>cancel upload</source>
             <translation>取消上传</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="342" />
+            <location filename="../../ui/messages.py" line="367" />
             <source>teach disable</source>
             <translation>示教禁止</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="343" />
+            <location filename="../../ui/messages.py" line="368" />
             <source>monitor</source>
             <translation>监视</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="344" />
+            <location filename="../../ui/messages.py" line="369" />
             <source>connect</source>
             <translation>连接</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="345" />
+            <location filename="../../ui/messages.py" line="370" />
             <source>disconnect</source>
             <translation>断开</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="346" />
+            <location filename="../../ui/messages.py" line="371" />
             <source>shutdown</source>
             <translation>关闭</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="347" />
+            <location filename="../../ui/messages.py" line="372" />
             <source>restart check</source>
             <translation>重启检测</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="348" />
+            <location filename="../../ui/messages.py" line="373" />
             <source>read registers</source>
             <translation>读取寄存器</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="350" />
+            <location filename="../../ui/messages.py" line="375" />
             <source>request</source>
             <translation>请求</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="353" />
+            <location filename="../../ui/messages.py" line="378" />
             <source>length</source>
             <translation>长度</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="354" />
+            <location filename="../../ui/messages.py" line="379" />
             <source>function code</source>
             <translation>功能码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="355" />
+            <location filename="../../ui/messages.py" line="380" />
             <source>byte count</source>
             <translation>字节数</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="356" />
+            <location filename="../../ui/messages.py" line="381" />
             <source>exception code</source>
             <translation>异常码</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="357" />
+            <location filename="../../ui/messages.py" line="382" />
             <source>address</source>
             <translation>地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="358" />
+            <location filename="../../ui/messages.py" line="383" />
             <source>value</source>
             <translation>数值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="359" />
+            <location filename="../../ui/messages.py" line="384" />
             <source>quantity</source>
             <translation>数量</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="360" />
+            <location filename="../../ui/messages.py" line="385" />
             <source>transaction id</source>
             <translation>事务标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="361" />
+            <location filename="../../ui/messages.py" line="386" />
             <source>protocol id</source>
             <translation>协议标识</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="362" />
+            <location filename="../../ui/messages.py" line="387" />
             <source>unit id</source>
             <translation>从站地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="363" />
+            <location filename="../../ui/messages.py" line="388" />
             <source>CRC</source>
             <translation>CRC 校验</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="367" />
+            <location filename="../../ui/messages.py" line="392" />
             <source>illegal function</source>
             <translation>非法功能</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="368" />
+            <location filename="../../ui/messages.py" line="393" />
             <source>illegal data address</source>
             <translation>非法数据地址</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="369" />
+            <location filename="../../ui/messages.py" line="394" />
             <source>illegal data value</source>
             <translation>非法数据值</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="370" />
+            <location filename="../../ui/messages.py" line="395" />
             <source>server device failure</source>
             <translation>从站设备故障</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="371" />
+            <location filename="../../ui/messages.py" line="396" />
             <source>acknowledge</source>
             <translation>已确认，处理中</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="372" />
+            <location filename="../../ui/messages.py" line="397" />
             <source>server device busy</source>
             <translation>从站设备忙</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="373" />
+            <location filename="../../ui/messages.py" line="398" />
             <source>negative acknowledge</source>
             <translation>否定应答</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="374" />
+            <location filename="../../ui/messages.py" line="399" />
             <source>memory parity error</source>
             <translation>存储奇偶校验错误</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="375" />
+            <location filename="../../ui/messages.py" line="400" />
             <source>gateway path unavailable</source>
             <translation>网关路径不可用</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="376" />
+            <location filename="../../ui/messages.py" line="401" />
             <source>gateway target device failed to respond</source>
             <translation>网关目标设备无响应</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="378" />
+            <location filename="../../ui/messages.py" line="403" />
             <source>unknown exception</source>
             <translation>未知异常</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="582" />
+            <location filename="../../ui/messages.py" line="607" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it: {cause}</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="585" />
+            <location filename="../../ui/messages.py" line="610" />
             <source>Stop sent (on the separate stop connection); the main connection did not take it.</source>
             <translation>停止已发出（经独立的停止连接）；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="631" />
+            <location filename="../../ui/messages.py" line="656" />
             <source>Stop sent to {endpoint} over a fresh connection (TeachPad was not connected to it).</source>
             <translation>停止已经由新建连接发送到 {endpoint}（TeachPad 当时未与其连接）。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="634" />
+            <location filename="../../ui/messages.py" line="659" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it: {cause}</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受：{cause}</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="638" />
+            <location filename="../../ui/messages.py" line="663" />
             <source>Stop sent to {endpoint} over a fresh connection; the main connection did not take it.</source>
             <translation>停止已经由新建连接发送到 {endpoint}；主连接未接受。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="641" />
+            <location filename="../../ui/messages.py" line="666" />
             <source>Stop could not reach the controller at {endpoint}: {cause} Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器：{cause} 请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="644" />
+            <location filename="../../ui/messages.py" line="669" />
             <source>Stop could not reach the controller at {endpoint}. Check the robot.</source>
             <translation>停止未能送达 {endpoint} 的控制器。请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="674" />
+            <location filename="../../ui/messages.py" line="699" />
             <source>{operation}: not sent, cancelled by Stop.</source>
             <translation>{operation}：未发送，已被停止取消。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="675" />
+            <location filename="../../ui/messages.py" line="700" />
             <source>{operation}: not sent, the upload was cancelled.</source>
             <translation>{operation}：未发送，上传已取消。</translation>
         </message>
@@ -2981,12 +3021,12 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>（减速模式）</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="591" />
+            <location filename="../../ui/messages.py" line="616" />
             <source>The controller at {endpoint} is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器 {endpoint} 无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
         <message>
-            <location filename="../../ui/messages.py" line="595" />
+            <location filename="../../ui/messages.py" line="620" />
             <source>The controller is not answering (the connection is still open): no further segment is sent. The arm may still finish its current move; check the robot before resuming.</source>
             <translation>控制器无应答（连接仍然打开）：不再发送后续段。机械臂可能仍会完成当前的移动；恢复运行前请检查机器人。</translation>
         </message>
@@ -4021,6 +4061,12 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <source>stopped by the operator</source>
             <translation>已由操作员停止</translation>
         </message>
+        <message>
+            <location filename="../../ui/controllers/plan_run_controller.py" line="705" />
+            <source>the controller did not confirm the Pause in time: Stop was sent instead</source>
+            <extracomment>How many of the segments sent a run remembers (``sent_segments``): a run with endless loops sends segments for as long as it runs.</extracomment>
+            <translation>控制器未在时限内确认暂停：已改为发送停止</translation>
+        </message>
     </context>
     <context>
         <name>PlanRunFlow</name>
@@ -4101,7 +4147,32 @@ The pendant connects to it and commands it; every other robot of the cell stays 
             <translation>运行轨迹</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_run.py" line="202" />
+            <location filename="../../ui/panels/planner_run.py" line="178" />
+            <source>Pausing… (waiting for the controller to confirm the Pause)</source>
+            <translation>正在暂停…（等待控制器确认暂停）</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_run.py" line="181" />
+            <source>Pausing — the controller has not confirmed: the arm may still be moving. Pause is sent again at every poll. Press STOP if it must stop now.</source>
+            <translation>正在暂停 — 控制器尚未确认：机械臂可能仍在运动。每次轮询都会重新发送暂停。如需立即停止，请按停止。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_run.py" line="186" />
+            <source>Pause not confirmed by the controller in time: Stop is sent instead, at every poll, until the controller takes it.</source>
+            <translation>控制器未在时限内确认暂停：改为在每次轮询时发送停止，直到控制器接受。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_run.py" line="190" />
+            <source>Paused (confirmed by the controller). Press Resume to go on.</source>
+            <translation>已暂停（控制器已确认）。按继续以继续运行。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_run.py" line="193" />
+            <source>Pause refused by the controller: the arm was not paused. Press STOP if it must stop now, or press Pause again.</source>
+            <translation>控制器拒绝了暂停：机械臂未暂停。如需立即停止，请按停止，或再次按暂停。</translation>
+        </message>
+        <message>
+            <location filename="../../ui/panels/planner_run.py" line="227" />
             <source>The upload did not complete: the plan was not started</source>
             <translation>上传未完成：轨迹未启动</translation>
         </message>
@@ -4328,12 +4399,12 @@ The pendant connects to it and commands it; every other robot of the cell stays 
     <context>
         <name>PlannerPanel</name>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="363" />
+            <location filename="../../ui/panels/planner_panel.py" line="364" />
             <source>This cell cannot be edited: {why}</source>
             <translation>无法编辑此单元格：{why}</translation>
         </message>
         <message>
-            <location filename="../../ui/panels/planner_panel.py" line="471" />
+            <location filename="../../ui/panels/planner_panel.py" line="472" />
             <source>Plan finished</source>
             <translation>轨迹运行完成</translation>
         </message>

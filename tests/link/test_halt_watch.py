@@ -120,3 +120,58 @@ def test_confirm_halt_retries_within_its_budget_and_says_when_it_could_not() -> 
     )
     assert clock[0] >= 2.0 and STOP in sent and never.unconfirmed
     assert "did not confirm the jog's speed 0 and Stop (441)" in never.words(clock[0])
+
+
+# --- a Pause the controller refused (HaltKind.PAUSE) ------------------------------------------------
+PAUSE = HaltWrite.PAUSE
+PAUSE_BOUND = 2.0
+
+
+def pause_watch(now: float = 0.0) -> HaltWatch:
+    return HaltWatch(HaltKind.PAUSE, None, now, escalate_after=PAUSE_BOUND)
+
+
+def test_a_refused_pause_goes_out_at_every_poll_and_is_over_once_answered_and_still() -> None:
+    halt = pause_watch()
+    for now in (0.0, 0.5, 1.0, 1.5):
+        assert halt.due(now) == (PAUSE,)  # never a speed 0, no Stop before the bound
+        halt.refused(PAUSE, BUSY)
+        assert not halt.pose_seen(at(600.0 + now)) and not halt.program_seen(False, False)
+    assert halt.state() == UnconfirmedHalt(HaltKind.PAUSE, 0.0, False)
+    halt.took(PAUSE, 1.6)
+    assert halt.due(1.7) == ()
+    assert not halt.pose_seen(at(700.0)) and halt.pose_seen(at(700.0))
+    assert halt.paused and halt.state() is None
+
+
+def test_a_pause_not_confirmed_within_the_bound_becomes_a_stop() -> None:
+    halt = pause_watch()
+    halt.refused(PAUSE, BUSY)
+    assert halt.due(PAUSE_BOUND) == (STOP,)  # instead of the Pause, not beside it
+    assert halt.state() == UnconfirmedHalt(HaltKind.PAUSE, 0.0, True)
+    halt.took(STOP, 2.1)
+    assert not halt.pose_seen(at(700.0)) and halt.pose_seen(at(700.0))
+    assert halt.over and not halt.paused and halt.answered_by is STOP
+
+
+def test_a_pause_refused_for_good_is_a_stop_at_once() -> None:
+    halt = pause_watch()
+    halt.refused(PAUSE, ILLEGAL_ADDRESS)
+    assert halt.due(0.05) == (STOP,)
+    halt.refused(STOP, ILLEGAL_ADDRESS)
+    assert halt.given_up  # nothing left that could halt the arm
+
+
+def test_a_pause_is_over_when_the_program_reads_paused_or_ended_and_still() -> None:
+    paused = pause_watch()
+    paused.refused(PAUSE, ResponseTimeout("no answer"))  # it may have been carried out
+    assert paused.program_seen(True, False) and paused.paused
+    ended = pause_watch()
+    ended.refused(PAUSE, BUSY)
+    assert not ended.program_seen(False, True)  # stopped: over once the pose is still
+    assert not ended.pose_seen(at(600.0)) and ended.pose_seen(at(600.0))
+    assert ended.over and not ended.paused
+    moving = pause_watch()
+    moving.refused(PAUSE, BUSY)
+    moving.program_seen(False, True)
+    assert not moving.pose_seen(at(600.0)) and not moving.pose_seen(at(610.0))  # still moving

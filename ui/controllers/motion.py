@@ -120,8 +120,8 @@ class MotionController(QObject):
     @Slot()
     def _on_pause_requested(self) -> None:
         """The window's Pause: a plan run under way is paused as its own Pause would (it then
-        holds its next move), anything else at the link."""
-        if self._runs.running and not self._runs.paused:
+        holds its next move; a Pause that failed is sent again through it), anything else at the link."""
+        if self._runs.can_pause:
             self._runs.pause()
         else:
             self._link.submit(Pause())

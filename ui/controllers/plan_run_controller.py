@@ -38,6 +38,14 @@ the other master's): the run tells it by arrival instead -- the arm stands at th
 point (the point guard's check): done; elsewhere: the run fails at that segment (the arm stopped
 if our pause holds it), "Resume from k" sends it again.
 
+**A Pause is over only when the controller answered it** (issue 19, item 1; app/link/halt.py):
+:meth:`pause` holds the next segment at once, but the run counts as *paused* only once the Pause's
+own request ends well (``pause_state``: :class:`PauseState`, ``pauseStateChanged``). Until then
+it is *pausing*; refused or unanswered, the worker sends it again at every poll and the link's
+``haltChanged`` says so (*pausing -- the controller has not confirmed*); a Pause that failed
+(refused for good, the link) leaves the run *not paused* (its next segment still held: Resume or
+Pause again), and a Pause the worker replaced by a Stop ends the run as stopped.
+
 How an ended run reads ("Failed at segment 2: ...") and what a link change means for it are
 :mod:`ui.controllers.plan_run_reasons`.
 """
@@ -45,6 +53,7 @@ How an ended run reads ("Failed at segment 2: ...") and what a link change means
 from __future__ import annotations
 
 import dataclasses
+import enum
 import time
 from collections import deque
 from collections.abc import Sequence
@@ -57,7 +66,7 @@ from app.errors import LinkError, TeachPadError
 from app.link.link_port import LinkPort, Pending
 from app.link.ops import MoveToPoint, Pause, Resume, Stop, UploadPoints
 from app.link.progress import PointUploaded, Progress
-from app.link.types import ConnectionState, LinkState, WorkerError
+from app.link.types import ConnectionState, HaltKind, LinkState, UnconfirmedHalt, WorkerError
 from app.models import CommandResult, Pose
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import MoveStatus
@@ -75,6 +84,18 @@ from ui.models.points_model import PointsModel
 if TYPE_CHECKING:  # app.plan.runner is imported where a run starts, after the first paint
     from app.plan.runner import PlanRunner, RunOutcome, RunProgress, SegmentCommand
     from app.safety.audit import AuditLog
+
+
+class PauseState(enum.Enum):
+    """Where the run's Pause is (the run box says it)."""
+
+    NONE = "none"  # not paused
+    PAUSING = "pausing"  # sent, not answered yet
+    UNCONFIRMED = "unconfirmed"  # refused or unanswered: sent again at every poll
+    STOPPING = "stopping"  # not confirmed in time: a Stop is sent instead
+    PAUSED = "paused"  # the controller confirmed it
+    REFUSED = "refused"  # it failed: the arm was not paused (the next segment is held)
+
 
 #: How many of the segments sent a run remembers (``sent_segments``): a run with endless loops
 #: sends segments for as long as it runs.
@@ -95,7 +116,8 @@ class PlanRunController(QObject):
     ``pointMismatch(int)`` (end point id: the arm did not arrive at the ledger's copy),
     ``pausedByForeign(str, float)`` (the run paused itself at a sign of another master: what and
     the value, as ``link.foreignMaster``; :func:`~ui.controllers.plan_run_reasons.foreign_pause_text`
-    says it), ``resumeRefused(str)`` (Resume did nothing: why, translated).
+    says it), ``resumeRefused(str)`` (Resume did nothing: why, translated),
+    ``pauseStateChanged(object)`` (:class:`PauseState`; ``pause_refusal`` says why a Pause failed).
     """
 
     runningChanged = Signal(bool)
@@ -109,6 +131,7 @@ class PlanRunController(QObject):
     pointMismatch = Signal(int)
     pausedByForeign = Signal(str, float)
     resumeRefused = Signal(str)
+    pauseStateChanged = Signal(object)
 
     def __init__(
         self, link: LinkPort | None = None, parent: QObject | None = None, *, points: PointsModel
@@ -117,7 +140,10 @@ class PlanRunController(QObject):
         self._link: LinkPort | None = None
         self._runner: PlanRunner | None = None
         self._plan: Plan | None = None
-        self._paused = False
+        self._paused = False  # the run holds its next segment (the operator or the run paused)
+        self._pause_state = PauseState.NONE
+        self._pause: Pending | None = None  # the Pause under way, until the controller answers it
+        self.pause_refusal = ""  # why the last Pause failed, translated
         self._guard = RunPoints(points)  # every run is guarded: there is no other path
         self._upload: Pending | None = None  # the re-creation of the running segment's points
         self._prepared: SegmentPoints | None = None  # the running segment's points, as sent
@@ -145,6 +171,7 @@ class PlanRunController(QObject):
         self._link = link
         link.state.connectionChanged.connect(self._on_connection)
         link.foreignMaster.connect(self._on_foreign_master)
+        link.state.haltChanged.connect(self._on_halt)
 
     @property
     def points(self) -> PointsModel:
@@ -168,7 +195,18 @@ class PlanRunController(QObject):
 
     @property
     def paused(self) -> bool:
+        """The run holds its next segment (paused by the operator or itself); whether the
+        controller confirmed the Pause is :attr:`pause_state`."""
         return self._paused
+
+    @property
+    def pause_state(self) -> PauseState:
+        return self._pause_state
+
+    @property
+    def can_pause(self) -> bool:
+        """Pause does something for the run: it runs and is not paused, or its last Pause failed."""
+        return self.running and (not self._paused or self._pause_state is PauseState.REFUSED)
 
     @property
     def plan(self) -> Plan | None:
@@ -270,9 +308,51 @@ class PlanRunController(QObject):
         self._send_next(link)
 
     def pause(self) -> None:
-        if self.running and not self._paused and self._link is not None:
-            self._link.submit(Pause())
-            self._set_paused(True)
+        """Hold the next segment and pause the controller; *paused* once it answered (see the
+        module docstring)."""
+        link = self._link
+        if not self.can_pause or link is None:
+            return
+        pause = link.track(link.submit(Pause()))
+        self._pause = pause
+        pause.finished.connect(lambda result: self._on_pause_result(pause, result))
+        pause.failed.connect(lambda error: self._on_pause_failed(pause, error))
+        self._set_paused(True)
+        if not pause.done:
+            self._set_pause_state(PauseState.PAUSING)
+
+    def _on_pause_result(self, pause: Pending, result: CommandResult) -> None:
+        """The Pause's outcome: answered (paused), or stopped instead / not carried out."""
+        if pause is not self._pause or not self._paused:
+            return
+        self._pause = None
+        if result.ok:
+            self._set_pause_state(PauseState.PAUSED)
+        elif result.reason is not None and result.reason.code == "pause_stopped":
+            self._set_pause_state(PauseState.STOPPING)  # the move ends as stopped: so does the run
+        else:
+            self._pause_failed(result_text(result))
+
+    def _on_pause_failed(self, pause: Pending, error: WorkerError) -> None:
+        if pause is self._pause and self._paused:
+            self._pause = None
+            self._pause_failed(error_text(error))
+
+    def _pause_failed(self, why: str) -> None:
+        self.pause_refusal = why
+        self._set_pause_state(PauseState.REFUSED)
+
+    @Slot(object)
+    def _on_halt(self, halt: UnconfirmedHalt | None) -> None:
+        """The link's word on a Pause it has not confirmed (sent again at every poll)."""
+        if self._pause is None or halt is None or halt.kind is not HaltKind.PAUSE:
+            return
+        self._set_pause_state(PauseState.STOPPING if halt.escalated else PauseState.UNCONFIRMED)
+
+    def _set_pause_state(self, state: PauseState) -> None:
+        if state is not self._pause_state:
+            self._pause_state = state
+            self.pauseStateChanged.emit(state)
 
     def resume(self) -> None:
         """Resume a paused move (not to be confused with :meth:`resume_run`); a move held
@@ -391,6 +471,8 @@ class PlanRunController(QObject):
     def _set_paused(self, paused: bool) -> None:
         if not paused:
             self._foreign_paused = False
+            self._pause = None  # a Pause still under way no longer speaks for the run
+            self._set_pause_state(PauseState.NONE)
         if paused != self._paused:
             self._paused = paused
             self.pausedChanged.emit(paused)
@@ -618,6 +700,12 @@ class PlanRunController(QObject):
         run ends *stopped by the operator* at it, never as a failure."""
         if not runner.stop_requested:
             runner.request_stop()
+        if self._pause_state is PauseState.STOPPING:  # the Pause, not confirmed in time, became a Stop
+            self.end_reason = self.tr(
+                "the controller did not confirm the Pause in time: Stop was sent instead"
+            )
+            self._by_operator = False
+            return
         self._mark_operator_stop()
 
     def _on_stop_failed(self, stop: Pending, error: WorkerError) -> None:

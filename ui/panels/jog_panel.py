@@ -371,6 +371,8 @@ class JogPanel(QWidget):
         self.hold_label.setStyleSheet(_HALT_STYLE)
         if halt.kind is HaltKind.RELEASE:
             text = self.tr("Releasing — the controller has not confirmed")
+        elif halt.kind is HaltKind.PAUSE:
+            text = self.tr("Pausing — the controller has not confirmed; press STOP")
         else:
             text = self.tr("Stopping — the controller has not confirmed")
         tip = self.tr(
@@ -378,7 +380,11 @@ class JogPanel(QWidget):
             "it again at every poll until the controller answers and the arm is seen still."
         )
         if halt.escalated:
-            tip += "\n" + self.tr("Stop was sent too.")
+            tip += "\n" + (
+                self.tr("The Pause was not confirmed in time: Stop was sent instead.")
+                if halt.kind is HaltKind.PAUSE
+                else self.tr("Stop was sent too.")
+            )
         self.hold_label.setText(text)
         self.hold_label.setToolTip(tip)
 

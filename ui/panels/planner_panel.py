@@ -45,7 +45,7 @@ from app.plan.runner import RunEvent, RunOutcome, RunProgress, RunState
 from app.plan.segments import Plan, SegmentKind
 from app.points.upload import UploadReport
 from app.safety.envelope import Envelope
-from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.plan_run_controller import PauseState, PlanRunController
 from ui.controllers.plan_run_reasons import foreign_pause_text
 from ui.controllers.point_sync import PointSyncController
 from ui.controllers.safety import lock_editing
@@ -145,6 +145,7 @@ class PlannerPanel(QWidget):
         r.runFinished.connect(self._on_run_finished)
         r.pausedByForeign.connect(self._on_paused_by_foreign)
         r.resumeRefused.connect(self._on_resume_refused)
+        r.pauseStateChanged.connect(self._on_pause_state)
         if r.link is not None:  # the pose's one signal, the link's picture of the robot
             r.link.state.poseChanged.connect(self.preview.on_pose)
             r.link.state.poseChanged.connect(self._on_pose)
@@ -490,6 +491,17 @@ class PlannerPanel(QWidget):
         self.run_box.show_paused(text)
         self.show_message(text, "warn")
 
+    @Slot(object)
+    def _on_pause_state(self, state: PauseState) -> None:
+        """The run's Pause: pausing until the controller confirms it, paused after, or refused
+        (issue 19): the run box says it, never "paused" before the controller did."""
+        text = self.run_flow.pause_text(state)
+        if text:
+            self.run_box.show_paused(text)
+        if state in (PauseState.UNCONFIRMED, PauseState.STOPPING, PauseState.REFUSED):
+            self.show_message(text, "error" if state is PauseState.REFUSED else "warn")
+        self._update_actions()
+
     @Slot(str)
     def _on_resume_refused(self, text: str) -> None:
         self.run_box.show_paused(text)
@@ -582,6 +594,8 @@ class PlannerPanel(QWidget):
             )
         )
         self.planner_actions.apply(states)
+        if r.can_pause:  # the run's last Pause failed: it can be pressed again (Resume stays)
+            self.planner_actions.all["pause"].setEnabled(True)
         if self._alarm_hold:  # an e-stop / servo alarm: nothing that starts motion (Stop, Pause stay)
             for name in ("run", "run_from", "step", "resume", "resume_from"):
                 self.planner_actions.all[name].setEnabled(False)

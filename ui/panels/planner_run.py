@@ -20,7 +20,7 @@ from app.plan.presenter import RunBlock, RunKind, run_gate, run_kind
 from app.plan.runner import RunOutcome, RunState
 from app.plan.segments import Plan
 from app.points.upload import UploadReport
-from ui.controllers.plan_run_controller import PlanRunController
+from ui.controllers.plan_run_controller import PauseState, PlanRunController
 from ui.controllers.point_sync import PointSyncController
 from ui.joins import join_names
 from ui.messages import error_text, refusal_text
@@ -171,6 +171,31 @@ class PlanRunFlow(QObject):
             self._view.show_message(str(exc), "error")
             return False
         return True
+
+    def pause_text(self, state: PauseState) -> str:
+        """The run box's words for the run's Pause (empty: nothing to say)."""
+        if state is PauseState.PAUSING:
+            return self.tr("Pausing… (waiting for the controller to confirm the Pause)")
+        if state is PauseState.UNCONFIRMED:
+            return self.tr(
+                "Pausing — the controller has not confirmed: the arm may still be moving. Pause is "
+                "sent again at every poll. Press STOP if it must stop now."
+            )
+        if state is PauseState.STOPPING:
+            return self.tr(
+                "Pause not confirmed by the controller in time: Stop is sent instead, at every poll, "
+                "until the controller takes it."
+            )
+        if state is PauseState.PAUSED:
+            return self.tr("Paused (confirmed by the controller). Press Resume to go on.")
+        if state is PauseState.REFUSED:
+            text = self.tr(
+                "Pause refused by the controller: the arm was not paused. Press STOP if it must stop "
+                "now, or press Pause again."
+            )
+            why = self._runner.pause_refusal
+            return f"{text} ({why})" if why else text
+        return ""
 
     def step_start(self, selected: Sequence[int]) -> int:
         """Where Step starts: the selected segment, else where the last step left off."""
