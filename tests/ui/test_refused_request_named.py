@@ -85,21 +85,29 @@ def _run_program(qtbot: Any, window: MainWindow, sim: Any) -> None:
     qtbot.waitUntil(lambda: sim.state().program_state == ProgramState.RUNNING, timeout=SIGNAL_TIMEOUT_MS)
 
 
-def test_a_refused_pause_names_pause_and_says_to_press_stop(qtbot: Any, sim: Any, window: MainWindow) -> None:
+def test_a_refused_pause_names_pause_says_to_press_stop_and_is_sent_again(
+    qtbot: Any, sim: Any, window: MainWindow
+) -> None:
+    """A Pause the controller answers "busy" during a program: the window says "Pausing — the
+    controller has not confirmed; press STOP" while the simulator's program runs on, sends it again
+    (app/link/halt.py), and says the Pause was confirmed once the simulator paused."""
     _run_program(qtbot, window, sim)
-    bar = window.control_bar
-    _refused(
-        window,
-        sim,
-        qtbot,
-        registers.REG_PAUSE,
-        lambda: qtbot.mouseClick(bar.pause_button, Qt.MouseButton.LeftButton),
-    )
-    state = sim.state()
-    assert state.program_state == ProgramState.RUNNING and state.moving and not state.paused  # not paused
-    text = _said(window, qtbot, "Pause refused by the controller (Modbus exception 6, server device busy)")
-    assert "the arm was not paused" in text and "Press STOP" in text, text
-    _in_chinese(window, "控制器拒绝了暂停（Modbus 异常 6，从站设备忙）")
+    bar, hold = window.control_bar, window.jog_panel.hold_label
+    refused = len(sim.refused_writes())
+    sim.set_exception(ExcCodes.DEVICE_BUSY, range(registers.REG_PAUSE, registers.REG_PAUSE + 1), seconds=1.0)
+    qtbot.mouseClick(bar.pause_button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: hold.text().startswith("Pausing"), timeout=SIGNAL_TIMEOUT_MS)
+    assert "press STOP" in hold.text(), hold.text()
+    assert sim.refused_writes()[refused].detail == f"write fc=0x06 address={registers.REG_PAUSE}: exception 6"
+    assert sim.state().program_state == ProgramState.RUNNING  # refused: not paused at the simulator
+    window.set_language("zh_CN")
+    assert_chinese(hold.text())
+    qtbot.waitUntil(lambda: sim.state().paused, timeout=SIGNAL_TIMEOUT_MS)  # sent again: paused
+    label = window.status_panel.command_label
+    qtbot.waitUntil(lambda: "暂停" in label.text(), timeout=SIGNAL_TIMEOUT_MS)
+    window.set_language("en")
+    assert label.text().startswith("Pause confirmed by the controller"), label.text()
+    assert not sim.writes_to(registers.REG_STOP)  # a busy second is not a Stop: resumable
     window.link.submit(Stop())
     qtbot.waitUntil(lambda: not sim.state().moving, timeout=SIGNAL_TIMEOUT_MS)
 
