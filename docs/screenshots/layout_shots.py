@@ -27,7 +27,8 @@ from app import timing  # noqa: E402
 from app.link.client import ConnectionSettings  # noqa: E402
 from app.link.robot_link import RobotLink  # noqa: E402
 from app.protocol.enums import Alarm, TeachFrame  # noqa: E402
-from app.sim import SimConfig, SimController  # noqa: E402
+from app.sim.config import SimConfig  # noqa: E402
+from app.sim.server import SimController  # noqa: E402
 from ui.i18n import Translator  # noqa: E402
 from ui.main_window import MainWindow  # noqa: E402
 from ui.settings import AppSettings  # noqa: E402

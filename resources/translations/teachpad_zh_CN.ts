@@ -991,22 +991,22 @@ The pendant connects to it and commands it; every other robot of the cell stays 
         </message>
         <message>
             <location filename="../../ui/dialogs/compare_points.py" line="130" />
-            <source>A: {a} ({n} points)</source>
+            <source>A: {a} (points: {n})</source>
             <translation>A：{a}（{n} 个点）</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/compare_points.py" line="132" />
-            <source>B: {b} ({n} points)</source>
+            <source>B: {b} (points: {n})</source>
             <translation>B：{b}（{n} 个点）</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/compare_points.py" line="136" />
-            <source>{n} differences; {same} points the same</source>
+            <source>Differences: {n}; points the same: {same}</source>
             <translation>{n} 处不同；{same} 个点相同</translation>
         </message>
         <message>
             <location filename="../../ui/dialogs/compare_points.py" line="139" />
-            <source>The same within the tolerances ({n} points)</source>
+            <source>The same within the tolerances (points: {n})</source>
             <translation>在容差范围内相同（{n} 个点）</translation>
         </message>
         <message>

@@ -127,16 +127,18 @@ class ComparePointsDialog(QDialog):
         )
         name_a, name_b = self._names
         self.sources.setText(
-            self.tr("A: {a} ({n} points)").format(a=name_a, n=diff.count_a)
+            self.tr("A: {a} (points: {n})").format(a=name_a, n=diff.count_a)
             + "\n"
-            + self.tr("B: {b} ({n} points)").format(b=name_b, n=diff.count_b)
+            + self.tr("B: {b} (points: {n})").format(b=name_b, n=diff.count_b)
         )
         if diff.differ:
             self.summary.setText(
-                self.tr("{n} differences; {same} points the same").format(n=len(diff.changes), same=diff.same)
+                self.tr("Differences: {n}; points the same: {same}").format(
+                    n=len(diff.changes), same=diff.same
+                )
             )
         else:
-            self.summary.setText(self.tr("The same within the tolerances ({n} points)").format(n=diff.same))
+            self.summary.setText(self.tr("The same within the tolerances (points: {n})").format(n=diff.same))
         self.table.setRowCount(len(diff.changes))
         for row, change in enumerate(diff.changes):
             self._fill(row, change)
