@@ -104,11 +104,14 @@ def test_reduced_speed_caps_the_program_run_step_move_and_jog(
     speeds = gv_values(csim, registers.GV_EXPECTED_SPEED)
     assert speeds[-1] == pytest.approx(caps.joint_rpm_cap, rel=1e-5) and caps.joint_rpm_cap < 5
 
+    # point 7 here, then a 5 mm step away: the move back to it moves (a move of no length is
+    # judged only by GV291's bounce off 255, which a poll spaced wider than the bounce -- a loaded
+    # machine -- misses and rightly reads "outcome unknown")
+    assert run(csim, capsys, "point", "create", "7")[0] == ExitCode.OK
     code, _, err = run(csim, capsys, "--reduced-speed", "step", "--frame", "base", "Z=-5", "--speed", "500")
     assert code == ExitCode.OK, err
     assert gv_values(csim, registers.GV_EXPECTED_SPEED)[-1] == REDUCED_SPEED_DEFAULT
 
-    assert run(csim, capsys, "point", "create", "7")[0] == ExitCode.OK  # here: the move ends where it is
     code, _, err = run(csim, capsys, "--reduced-speed", "move", "7", "--speed", "800")
     assert code == ExitCode.OK, err
     assert gv_values(csim, registers.GV_EXPECTED_SPEED)[-1] == REDUCED_SPEED_DEFAULT

@@ -80,7 +80,11 @@ def test_a_stop_is_timed_as_the_simulator_recorded_it(
     assert result.kind is StopKind.STOP
     assert not sim.state().moving
     _check_against_the_simulator(result, sim, at_click, STEP_SPEED)
-    assert result.distance_mm > 0.0  # the arm was moving at the click
+    # the arm went on after the click as far as the simulator says (on a loaded machine its motion
+    # ticker may not have moved it between the last poll before the click and the Stop: 0 mm then)
+    moved_after_click = math.dist(at_click["pose"][:3], sim.rest_records()[-1].pose[:3])
+    if moved_after_click > 0.1:
+        assert result.distance_mm > 0.0
     # the monitor says it
     label = window.monitor_panel.last_stop_label.text()
     assert label == f"Last stop: {result.ms} ms, {result.distance_mm:.1f} mm"
