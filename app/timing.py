@@ -125,6 +125,7 @@ GATEWAY_BROKER_RETRY = (
 )  # whole s: paho's reconnect delay to the broker (first, doubling to the largest)
 GATEWAY_CLOCK_PERIOD = 1.0  # s between reads of the controller's clock (with the status block)
 GATEWAY_STOP_WAIT = 2.0  # s a stopping gateway waits for its NDEATH to be sent
+GATEWAY_STOP_BOUND = 10.0  # s teachpad-gateway's whole stop may take after SIGTERM/SIGINT; then it exits
 # DDATA kept while the broker is away (sent flagged is_historical when it is back); older ones are dropped
 GATEWAY_HISTORY_LIMIT = 10_000
 # A plant write (DCMD) is refused while another master was seen on that controller this recently (s):

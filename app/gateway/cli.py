@@ -18,6 +18,7 @@ import signal
 import socket
 import sys
 import threading
+import traceback
 from collections.abc import Sequence
 from pathlib import Path
 from urllib.parse import urlsplit
@@ -197,5 +198,26 @@ def main(argv: Sequence[str] | None = None) -> int:
         if reload.is_set():
             reload.clear()
             _reload(edge, args.cell)
-    edge.stop()
+    _stop(edge)
     return 0
+
+
+def _stop(edge: EdgeNode) -> None:
+    """NDEATH and a clean disconnect, within :data:`app.timing.GATEWAY_STOP_BOUND`: a SIGTERM ends
+    the process whatever part of the stop does not end (its threads are daemons; the broker then
+    sends the will, the NDEATH of this session). What did not end is said, with every thread's
+    stack, so that a stop that hangs is seen and can be found (once, in a CI run of stop 28)."""
+    stopper = threading.Thread(target=edge.stop, name="gateway-stop", daemon=True)
+    stopper.start()
+    stopper.join(timing.GATEWAY_STOP_BOUND)
+    if stopper.is_alive():
+        print(
+            f"{PROG}: warning: the stop did not end within {timing.GATEWAY_STOP_BOUND:g} s: exiting "
+            "(the broker sends the will); the threads were:",
+            file=sys.stderr,
+            flush=True,
+        )
+        names = {t.ident: t.name for t in threading.enumerate()}
+        for ident, frame in sys._current_frames().items():
+            print(f"--- thread {names.get(ident, ident)}", file=sys.stderr)
+            print("".join(traceback.format_stack(frame)), end="", file=sys.stderr, flush=True)

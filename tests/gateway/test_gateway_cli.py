@@ -7,6 +7,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 from typing import Any
@@ -187,3 +188,30 @@ def test_an_envelope_that_cannot_be_read_when_plant_writes_need_it_is_one_line_a
         capsys, str(cell), "--broker", "mqtt://127.0.0.1:1", "--bdseq-file", str(tmp_path / "b.json")
     )
     assert "envelope.safety.json" in err
+
+
+def test_a_stop_that_does_not_end_still_ends_the_process_and_says_where_it_hung(
+    monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """SIGTERM ends teachpad-gateway even when a part of its stop hangs (seen once in a CI run: the
+    process outlived its 30 s): the stop is bounded, and every thread's stack is said."""
+    from app import timing
+    from app.gateway import cli
+
+    release = threading.Event()
+
+    class HangingNode:
+        def stop(self) -> None:
+            release.wait(30)  # a join that never ends
+
+    monkeypatch.setattr(timing, "GATEWAY_STOP_BOUND", 0.2)
+    started = time.monotonic()
+    try:
+        cli._stop(HangingNode())  # type: ignore[arg-type]
+        took = time.monotonic() - started
+    finally:
+        release.set()
+    err = capsys.readouterr().err
+    assert took < 5.0  # bounded (0.2 s asked; generous for a loaded machine)
+    assert "the stop did not end within 0.2 s" in err
+    assert "--- thread gateway-stop" in err and "release.wait(30)" in err  # where it hung
