@@ -133,6 +133,12 @@ class MonitorPanel(QWidget):
         controls.addWidget(self.window_combo)
         controls.addWidget(self.pause_button)
         controls.addStretch(1)
+        # measured stopping (ui/controllers/stop_timing.py): "Last stop: 180 ms, 4.2 mm", in the
+        # controls' free width (beside the plots' status line it cut that line under wider fonts)
+        self.last_stop_label = QLabel(self)
+        self.last_stop_label.setObjectName("LastStopLabel")
+        controls.addWidget(self.last_stop_label)
+        controls.addSpacing(12)
         controls.addWidget(self.clear_trace_button)
 
         # Plots: built after the window's first paint (_build_plots); a placeholder keeps their place.
@@ -144,15 +150,8 @@ class MonitorPanel(QWidget):
 
         self._status = QLabel(self)
         self._status.setStyleSheet(f"color: {COLOR_NEUTRAL};")
-        # measured stopping (ui/controllers/stop_timing.py): "Last stop: 180 ms, 4.2 mm"
-        self.last_stop_label = QLabel(self)
-        self.last_stop_label.setObjectName("LastStopLabel")
         self._last_stop: StopMeasurement | None = None
         self._stops_measured = 0
-        bottom = QHBoxLayout()
-        bottom.setContentsMargins(0, 0, 0, 0)
-        bottom.addWidget(self._status, 1)
-        bottom.addWidget(self.last_stop_label)
 
         layout = QVBoxLayout(self)
         layout.setContentsMargins(PANEL_MARGIN, PANEL_MARGIN, PANEL_MARGIN, PANEL_MARGIN)
@@ -161,7 +160,7 @@ class MonitorPanel(QWidget):
         layout.addWidget(boxes.axes_box)
         layout.addLayout(controls)
         layout.addWidget(plots, 1)
-        layout.addLayout(bottom)
+        layout.addWidget(self._status)
         self._layout = layout
         self.retranslate()
 
