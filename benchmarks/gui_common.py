@@ -190,7 +190,8 @@ class LocalSim:
 # The simulator in its own interpreter, like a controller on the network; queried over a pipe.
 _SIM_HOST_CHILD = r"""
 import json, sys
-from app.sim import SimConfig, SimController
+from app.sim.config import SimConfig
+from app.sim.server import SimController
 sim = SimController(SimConfig(host="127.0.0.1", port=0))
 sim.start()
 print(json.dumps([sim.port, sim.config.unit]), flush=True)

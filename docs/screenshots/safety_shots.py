@@ -31,7 +31,8 @@ from app.link.types import JogRequest  # noqa: E402
 from app.protocol.enums import TeachFrame  # noqa: E402
 from app.safety.envelope import Box, Envelope  # noqa: E402
 from app.safety.roles import Action, Role  # noqa: E402
-from app.sim import SimConfig, SimController  # noqa: E402
+from app.sim.config import SimConfig  # noqa: E402
+from app.sim.server import SimController  # noqa: E402
 from ui.controllers.safety_menu import install_safety  # noqa: E402
 from ui.dialogs.envelope_dialog import EnvelopeDialog  # noqa: E402
 from ui.i18n import Translator  # noqa: E402

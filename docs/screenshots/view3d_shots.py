@@ -24,7 +24,8 @@ sys.path.insert(0, str(REPO))
 from app import timing  # noqa: E402
 from app.link.client import ConnectionSettings  # noqa: E402
 from app.link.robot_link import RobotLink  # noqa: E402
-from app.sim import SimConfig, SimController  # noqa: E402
+from app.sim.config import SimConfig  # noqa: E402
+from app.sim.server import SimController  # noqa: E402
 from app.view3d.camera import Preset  # noqa: E402
 from ui.i18n import Translator  # noqa: E402
 from ui.main_window import MainWindow  # noqa: E402
