@@ -44,8 +44,12 @@ class WindowStatusBar(QObject):
     def bind(self, state: RobotState) -> None:
         self._state = state
         state.connectionChanged.connect(self._on_connection)
-        state.rttChanged.connect(lambda _ms: self._show_rtt())
+        state.rttChanged.connect(self._on_rtt)  # a slot of this object: gone with the window
         self._show_connection()
+        self._show_rtt()
+
+    @Slot(float)
+    def _on_rtt(self, _ms: float) -> None:
         self._show_rtt()
 
     def retranslate(self) -> None:
