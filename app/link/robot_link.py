@@ -297,10 +297,17 @@ class RobotLink(QObject):
 
     def set_motion_caps(self, caps: MotionCaps | None) -> None:
         """Reduced-speed mode's caps, applied by the worker's client to every speed it writes
-        (None: not reduced). Queued: a request made after this call is capped."""
+        (None: not reduced). A request made after this call is capped: the caps (immutable) are
+        set on the worker at once -- a queued call alone came after a motion the worker took from
+        its queue inside a poll -- and again by the queued call, in the worker's thread (a client
+        it made meanwhile gets them too)."""
         if not self._shut:
             self._caps = caps
             if self._made is not None:
+                self._made.caps = caps  # read by the worker when it makes or runs a motion
+                client = self._made.supervisor.client
+                if client is not None:
+                    client.caps = caps
                 self._capsRequested.emit(caps)
 
     def set_audit(self, audit: AuditLog | None) -> None:
