@@ -24,9 +24,11 @@ from PySide6.QtCore import QEvent, QObject, QTimer, Signal
 from PySide6.QtWidgets import QApplication, QWidget
 
 from ui.gui_gc import GuiThreadCollector
+from ui.pyside_scan import skip_source_scan
 from ui.startup_gc import StartupGcPause, gc_paused
 
-with gc_paused():  # the window's modules: many objects made, almost none freed (ui/startup_gc.py)
+skip_source_scan()  # PySide reads the source of none of the modules below (ui/pyside_scan.py)
+with gc_paused(freeze=True):  # the window's modules: many objects made, none freed (ui/startup_gc.py)
     from app.connection import ConnectionSettings
     from app.link.ops import RunProgram
     from app.link.robot_link import RobotLink, wait_for_detached_threads

@@ -17,10 +17,9 @@ from PySide6.QtCore import QEvent, QObject, Slot
 from PySide6.QtGui import QAction
 
 from app.errors import InvalidInput
-from app.points.diff import load_points_source
 from ui.messages import os_error_text, refusal_text
 
-if TYPE_CHECKING:  # the dialog's module loads with the first comparison, not at start-up
+if TYPE_CHECKING:  # the dialog's and the diff's modules load with the first comparison, not at start-up
     from ui.dialogs.compare_points import ComparePointsDialog
 
 __all__ = ["ComparePoints", "install_compare"]
@@ -68,6 +67,8 @@ class ComparePoints(QObject):
 
     def compare_with(self, path: str | os.PathLike[str]) -> ComparePointsDialog | None:
         """Compare the project's points (A) with the file's (B) and show the dialog."""
+        from app.points.diff import load_points_source
+
         project = self.window.project
         try:
             other = load_points_source(path, project.project.ledger.limits)

@@ -33,11 +33,11 @@ from app.models import CommandResult
 from app.safety.roles import Action
 from app.watchlist.entry import WatchEntry, format_value
 from app.watchlist.history import WatchHistory
-from app.watchlist.plan import WatchReadings
 from ui.messages import error_text, result_text
 
 if TYPE_CHECKING:
     from app.points.project_model import Project
+    from app.watchlist.plan import WatchReadings
     from ui.panels.watch_list_panel import WatchListPanel
 
 __all__ = ["WatchListHost", "install_watch_list"]

@@ -61,7 +61,6 @@ from app.plan.segments import (
     validate_plan_name,
 )
 from app.points.atomic import atomic_write_bytes, read_limited
-from app.points.csv_io import decode_text, parse_points_csv, points_to_csv
 from app.points.fields import DEFAULT_LIMITS, FieldError, OversizedNumber, PointLimits, has_surrogates, shown
 from app.points.ledger import PointLedger
 from app.points.point import (
@@ -426,6 +425,8 @@ def _parse_project_exact(text: str, limits: PointLimits, *, path: str | None) ->
 
 
 def load_project(path: str | os.PathLike[str], limits: PointLimits = DEFAULT_LIMITS) -> Project:
+    from app.points.csv_io import decode_text  # (csv: imported by the first file read, not at start-up)
+
     p = Path(path)
     return parse_project(decode_text(read_limited(p), str(p)), limits, path=str(p))
 
@@ -446,6 +447,8 @@ def read_points_csv(
 ) -> list[TempPoint]:
     """The file's points, each recording that it was imported from this file, now (``made``:
     another provenance, e.g. with the controller the link reaches)."""
+    from app.points.csv_io import decode_text, parse_points_csv
+
     p = Path(path)
     points = parse_points_csv(decode_text(read_limited(p), str(p)), limits, path=str(p))
     if made is None:
@@ -456,5 +459,7 @@ def read_points_csv(
 def write_points_csv(path: str | os.PathLike[str], points: Iterable[TempPoint], *, bom: bool = True) -> None:
     """Write points as CSV, atomically; with a BOM by default so spreadsheet programs read the
     Chinese names as UTF-8."""
+    from app.points.csv_io import points_to_csv
+
     text = points_to_csv(points)
     atomic_write_bytes(path, (("\ufeff" + text) if bom else text).encode("utf-8"))

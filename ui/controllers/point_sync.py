@@ -40,6 +40,7 @@ and the point becomes *unknown*.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import TYPE_CHECKING
 
 from PySide6.QtCore import QObject, Signal, Slot
 
@@ -53,11 +54,13 @@ from app.points.point import SyncState
 from app.points.upload import UploadReport
 from app.protocol.enums import MoveStatus
 from app.protocol.registers import TOOL_NONE
-from ui.controllers.new_point import NewPointPose, new_point_pose
 from ui.controllers.point_sync_state import UploadTally, batch_reason, pose_from_details, result_reason
 from ui.controllers.run_points import RunPoints, SegmentPoints
 from ui.messages import connection_text, error_text, refusal_text, result_text
 from ui.models.points_model import PointsModel
+
+if TYPE_CHECKING:
+    from ui.controllers.new_point import NewPointPose
 
 DEFAULT_MOVE_SPEED = 50.0  # mm/s for "move to point"
 MAX_MOVE_SPEED = 1000.0
@@ -141,6 +144,8 @@ class PointSyncController(QObject):
     def new_point_pose(self, near_row: int | None = None) -> NewPointPose:
         """The pose for a point added by hand: the robot's while the link is fresh, else the
         point at ``near_row`` (default: the last one) or zeros (see :mod:`ui.controllers.new_point`)."""
+        from ui.controllers.new_point import new_point_pose  # the first point added by hand
+
         state = self._link.state if self._link is not None else None
         return new_point_pose(
             state is not None and state.fresh,

@@ -123,12 +123,21 @@ class ReadoutBoxes:
     def _largest_fitting(
         self, readouts: list[NumericReadout], wanted: float, least: float, room: float
     ) -> float:
-        """The largest size from ``wanted`` down to ``least`` at which each of ``readouts`` fits
-        ``room`` px (``least`` when none does)."""
-        points = wanted
-        while points > least and max(self._width(r, points) for r in readouts) > room:
-            points = max(least, round(points - POINTS_STEP, 1))
-        return points
+        """The largest size of the steps from ``wanted`` down to ``least`` at which each of
+        ``readouts`` fits ``room`` px (``least`` when none does). A readout's width grows with its
+        size, so the steps are bisected: ~4 sizes measured, not up to 20 (each size of each readout
+        is a font to make and measure, before the window's first paint)."""
+        steps = [wanted]
+        while steps[-1] > least:
+            steps.append(max(least, round(steps[-1] - POINTS_STEP, 1)))
+        low, high = 0, len(steps) - 1  # the answer's index; steps[high] (least) when none fits
+        while low < high:
+            middle = (low + high) // 2
+            if max(self._width(r, steps[middle]) for r in readouts) <= room:
+                high = middle
+            else:
+                low = middle + 1
+        return steps[low]
 
     @staticmethod
     def _column_room(box: QGroupBox, grid: QGridLayout, width: int, columns: int) -> float:
