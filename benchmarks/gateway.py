@@ -82,11 +82,16 @@ def _cpu_of(pid: int) -> float:
 
 # -- simulators in processes ---------------------------------------------------------------
 class SimProcess:
-    """``teachpad-sim --controllers N`` in its own process; its ports from its stdout."""
+    """``teachpad-sim --controllers N`` in its own process; its ports from its stdout. ``idle``: no
+    program runs (``--controllers 1 --idle`` is a plain ``teachpad-sim``); ``tick_hz`` None: the
+    simulator's default ticker. SIGSTOP of :attr:`pid` stops it dead (it accepts and answers
+    nothing, as a hung controller); :meth:`stop` continues it first. The benchmarks' and the tests'
+    one way to run simulators in a process of their own (tests/gateway/test_death_rule.py)."""
 
-    def __init__(self, count: int, *, idle: bool = False) -> None:
+    def __init__(self, count: int = 1, *, idle: bool = False, tick_hz: float | None = SIM_TICK_HZ) -> None:
         command = [sys.executable, "-m", "app.sim.cli", "--port", "0", "--controllers", str(count)]
-        command += ["--tick-hz", str(SIM_TICK_HZ), "--no-stdin", "--stop-with-stdin"]
+        command += [] if tick_hz is None else ["--tick-hz", str(tick_hz)]
+        command += ["--no-stdin", "--stop-with-stdin"]
         self.proc = subprocess.Popen(
             command + (["--idle"] if idle else []),
             cwd=ROOT,
@@ -112,6 +117,11 @@ class SimProcess:
     def pid(self) -> int:
         return self.proc.pid
 
+    @property
+    def port(self) -> int:
+        """The (first) controller's port."""
+        return self.ports[0]
+
     def stop(self) -> None:
         os.kill(self.proc.pid, signal.SIGCONT)  # a stopped one must run to stop
         assert self.proc.stdin is not None
@@ -121,6 +131,8 @@ class SimProcess:
         except subprocess.TimeoutExpired:
             self.proc.kill()
             self.proc.wait(5.0)
+        if self.proc.stdout is not None:
+            self.proc.stdout.close()
 
 
 @contextmanager

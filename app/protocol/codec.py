@@ -13,6 +13,8 @@ import numbers
 import struct
 from collections.abc import Iterable, Sequence
 
+from app.enum_alias import parse_enum
+
 
 class WordOrder(enum.Enum):
     """Order of the two 16-bit words of a float32."""
@@ -23,21 +25,12 @@ class WordOrder(enum.Enum):
     @classmethod
     def parse(cls, text: str) -> WordOrder:
         """Accept ``low-first``/``high-first`` (and ``little``/``big``)."""
-        key = text.strip().lower()
-        aliases = {
-            "little": cls.LOW_FIRST,
-            "low": cls.LOW_FIRST,
-            "cdab": cls.LOW_FIRST,
-            "big": cls.HIGH_FIRST,
-            "high": cls.HIGH_FIRST,
-            "abcd": cls.HIGH_FIRST,
-        }
-        for member in cls:
-            if member.value == key:
-                return member
-        if key in aliases:
-            return aliases[key]
-        raise ValueError(f"unknown word order {text!r} (use low-first or high-first)")
+        aliases = {cls.LOW_FIRST: ("little", "low", "cdab"), cls.HIGH_FIRST: ("big", "high", "abcd")}
+        return parse_enum(cls, text, aliases, _unknown_word_order)
+
+
+def _unknown_word_order(text: str) -> ValueError:
+    return ValueError(f"unknown word order {text!r} (use low-first or high-first)")
 
 
 # The two word orders as byte orders: a float32 packed little-endian reads, as little-endian

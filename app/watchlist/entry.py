@@ -19,6 +19,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from app.enum_alias import parse_enum
 from app.errors import InvalidInput
 from app.protocol.codec import FLOAT32_MAX, WordOrder, decode_floats, encode_floats
 
@@ -62,24 +63,17 @@ class ValueType(enum.Enum):
 
     @classmethod
     def parse(cls, text: str) -> ValueType:
-        key = text.strip().lower()
-        aliases = {
-            "float": cls.FLOAT32,
-            "f32": cls.FLOAT32,
-            "i16": cls.INT16,
-            "int": cls.INT16,
-            "bit": cls.BITS,
-        }
-        for member in cls:
-            if member.value == key:
-                return member
-        if key in aliases:
-            return aliases[key]
-        raise InvalidInput(
-            f"unknown type {text[:20]!r}: use float32, int16 or bits",
-            code="watch_bad_type",
-            params={"type": text[:20]},
-        )
+        """Accept ``float32``/``int16``/``bits`` (and ``float``, ``f32``, ``int``, ``i16``, ``bit``)."""
+        aliases = {cls.FLOAT32: ("float", "f32"), cls.INT16: ("i16", "int"), cls.BITS: ("bit",)}
+        return parse_enum(cls, text, aliases, _unknown_type)
+
+
+def _unknown_type(text: str) -> InvalidInput:
+    return InvalidInput(
+        f"unknown type {text[:20]!r}: use float32, int16 or bits",
+        code="watch_bad_type",
+        params={"type": text[:20]},
+    )
 
 
 def _number(value: object, hi: int, what: str) -> int:

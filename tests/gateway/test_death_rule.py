@@ -7,8 +7,6 @@ from __future__ import annotations
 
 import os
 import signal
-import subprocess
-import sys
 import time
 from collections.abc import Iterator
 from pathlib import Path
@@ -17,59 +15,18 @@ from typing import Any
 import pytest
 
 from app import timing
+from benchmarks.gateway import SimProcess
 
 from .conftest import Subscriber
 from .test_sparkplug import wait_until
 
-ROOT = Path(__file__).resolve().parents[2]
-START_TIMEOUT = 30.0  # s for a simulator process to say where it listens (a loaded machine)
 DDEATH_BOUND = 0.25  # s from silence to the subscriber's DDEATH (issue 23)
 DEATH_WINDOW = 0.6  # s: the late answers' test (its subject is the rule, not the product's window)
 
 
-class SimProcess:
-    """``teachpad-sim --port 0`` in its own process (SIGSTOP stops it dead: it accepts and answers
-    nothing, as a hung controller); its port from its stdout."""
-
-    def __init__(self) -> None:
-        command = [sys.executable, "-m", "app.sim.cli", "--port", "0", "--no-stdin", "--stop-with-stdin"]
-        self.proc = subprocess.Popen(
-            command,
-            cwd=ROOT,
-            stdin=subprocess.PIPE,
-            stdout=subprocess.PIPE,
-            stderr=subprocess.DEVNULL,
-            text=True,
-        )
-        assert self.proc.stdout is not None
-        self.port = 0
-        deadline = time.monotonic() + START_TIMEOUT
-        while not self.port and time.monotonic() < deadline:
-            line = self.proc.stdout.readline()
-            if not line:
-                break
-            if "listening on" in line:
-                self.port = int(line.split("listening on ")[1].split()[0].rsplit(":", 1)[1])
-        if not self.port:
-            self.stop()
-            pytest.fail("the simulator process did not say where it listens")
-
-    def stop(self) -> None:
-        os.kill(self.proc.pid, signal.SIGCONT)  # a stopped one must run to stop
-        assert self.proc.stdin is not None
-        self.proc.stdin.close()  # --stop-with-stdin
-        try:
-            self.proc.wait(10.0)
-        except subprocess.TimeoutExpired:
-            self.proc.kill()
-            self.proc.wait(5.0)
-        if self.proc.stdout is not None:
-            self.proc.stdout.close()
-
-
 @pytest.fixture
 def sim_process() -> Iterator[SimProcess]:
-    sim = SimProcess()
+    sim = SimProcess(1, idle=True, tick_hz=None)  # a plain teachpad-sim: no program, its own ticker
     try:
         yield sim
     finally:
@@ -129,10 +86,10 @@ def test_a_sigstopped_controller_is_dead_within_250_ms(
         start = subscriber.count()
         wait_until(lambda: _data_since(subscriber, start, "R2"), "a DDATA of R2 (it answers)")  # noqa: B023
         stopped_at = time.monotonic()
-        os.kill(sim_process.proc.pid, signal.SIGSTOP)
+        os.kill(sim_process.pid, signal.SIGSTOP)
         death = subscriber.kind("DDEATH", "R2", start=start)
         took.append(death.at - stopped_at)
-        os.kill(sim_process.proc.pid, signal.SIGCONT)
+        os.kill(sim_process.pid, signal.SIGCONT)
         subscriber.kind("DBIRTH", "R2", start=subscriber.messages.index(death))
     assert max(took) <= DDEATH_BOUND, f"DDEATH {[round(t * 1000) for t in took]} ms after SIGSTOP"
     assert not [m for m in subscriber.snapshot() if m.kind == "DDEATH" and m.device == "R1"]

@@ -5,7 +5,6 @@ main link fails, nothing queued before it runs after it."""
 from __future__ import annotations
 
 import time
-from collections.abc import Iterator
 from typing import Any
 
 import pytest
@@ -25,19 +24,6 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
 )
 
 pytestmark = pytest.mark.timeout(60)
-
-
-@pytest.fixture(name="main_only_link")
-def main_only_link_fixture(qtbot: Any, fast_reconnect: None) -> Iterator[RobotLink]:
-    """A RobotLink without the stop line: every stop goes on the main link alone. (With a line
-    that opened before a test slowed the simulator, the line's 441 may be answered in time: the
-    Stop then rightly succeeds -- tests/link/test_stop_line_only.py -- whatever the main link did.)"""
-    robot_link = RobotLink(poll_hz=timing.POLL_HZ_DEFAULT, canary_gv=None, stop_line=False)
-    try:
-        yield robot_link
-    finally:
-        robot_link.shutdown()
-        assert not robot_link.is_running
 
 
 def _poses(sim: Any, ids: range) -> list[tuple[int, tuple[float, ...], int]]:
