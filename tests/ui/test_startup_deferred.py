@@ -35,7 +35,14 @@ DEFERRED = (
     "importlib.resources",  # the shipped robot profile: read by its first use
     "ui.keypad",  # the on-screen keypad: touch mode on, or a field that has one
     "hashlib",  # passwords (OpenSSL): the first one set or checked
+    "app.points.diff",  # File → Compare with…: the first comparison
+    "app.points.csv_io",  # a points CSV or a project: the first file read or written
+    "ui.controllers.new_point",  # the first point added by hand
+    "app.watchlist.plan",  # the watch list's reads: the worker's, once connected
 )
+# Imported before ui/main.py enters TeachPad's modules in PySide's feature table (ui/pyside_scan.py):
+# the only ones of TeachPad whose source PySide reads
+SCANNED_BEFORE = {"ui", "ui.gui_gc", "ui.pyside_scan", "ui.startup_gc"}
 # Qt classes made ready (shiboken) by their first use: the dialogs, when one is shown
 # (PySide6 makes a class when it is first looked up: its module's namespace holds only those made)
 DEFERRED_QT = ("QDialog", "QMessageBox", "QFileDialog", "QInputDialog")
@@ -52,10 +59,16 @@ def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint
         import PySide6.QtWidgets
         from PySide6.QtCore import QTimer
         from PySide6.QtWidgets import QApplication
+
+        feature = sys.modules["shibokensupport.feature"]  # PySide's source scan, noted
+        scanned, scan = [], feature._mod_uses_pyside
+        feature._mod_uses_pyside = lambda module: scanned.append(module.__name__) or scan(module)
         import ui.main as teachpad
 
         DEFERRED, DEFERRED_QT = json.loads(sys.argv[2])
         after_import = gc.isenabled()  # the pause over the imports has ended with them
+        frozen_after_import = gc.get_freeze_count() > 0  # and froze what they made
+        own_scanned = sorted(m for m in scanned if m.split(".")[0] in ("app", "ui"))
 
         class Probe(teachpad.MainWindow):
             def paintEvent(self, event):
@@ -69,6 +82,7 @@ def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint
             def _report(self):
                 print("STARTUP " + json.dumps([self.seen, after_import, self.gc_at_paint, gc.isenabled(),
                                                gc.get_freeze_count() > 0]), flush=True)
+                print("IMPORT " + json.dumps([frozen_after_import, own_scanned]), flush=True)
                 QApplication.instance().exit(0)
 
         teachpad.MainWindow = Probe
@@ -102,6 +116,10 @@ def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint
     # objects of the start-up frozen
     assert gc_after_paint is False and frozen_after_paint is True
     assert lines["AFTER_MAIN"] is True
+    frozen_after_import, own_scanned = lines["IMPORT"]
+    assert frozen_after_import is True  # the modules' objects are not walked by the next collection
+    # PySide read the source of none of the window's modules (ui/pyside_scan.py; it read ~140)
+    assert set(own_scanned) <= SCANNED_BEFORE, own_scanned
 
 
 def test_a_pause_resumes_once_and_only_a_collector_that_was_on() -> None:
