@@ -285,7 +285,10 @@ def _edge_node(ports: Sequence[int], broker_port: int, poll_timeout: float | Non
         node="gw",
         gateway=GatewayTiming(poll_hz=POLL_HZ, poll_timeout=poll_timeout),
     )
-    node.answers_at = {}
+    # every controller's list made before the pollers start: they only append, so this thread can
+    # read the dict while they answer (one that added its own key raced _settle's read: "dictionary
+    # changed size during iteration" lost every gateway figure of a make bench)
+    node.answers_at = {controller.name: [] for controller in cell.controllers}
     node.handed_over = []
     return node
 

@@ -9,6 +9,8 @@ A figure without samples is null in the JSON with a ``not_measured`` reason besi
 
 from __future__ import annotations
 
+import sys
+import traceback
 from collections.abc import Callable
 from typing import Any
 
@@ -228,6 +230,7 @@ def guarded(name: str, body: Callable[[], dict[str, Any]]) -> dict[str, Any]:
     try:
         return body()
     except Exception as exc:  # the benchmark reports, it does not crash
+        traceback.print_exc(file=sys.stderr)  # where it failed: the JSON has room for the reason only
         return {"not_measured": f"{name} failed: {type(exc).__name__}: {str(exc)[:300]}"}
 
 

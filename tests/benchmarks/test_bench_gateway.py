@@ -36,3 +36,13 @@ def test_the_gateway_suite_quick_run_prints_its_keys_beside_their_goals() -> Non
     for key in GATEWAY_KEYS:
         assert entries[key]["met"] in (True, False) and entries[key]["bound"] is not None
     assert {key for key, *_ in GOALS} >= set(GATEWAY_KEYS)
+
+
+def test_every_controller_has_its_answer_list_before_the_pollers_start() -> None:
+    # The pollers only append to their lists, so the bench's thread may read the dict while they
+    # answer; a poller adding its own key raced that read once ("dictionary changed size during
+    # iteration" lost every gateway figure of a make bench).
+    from benchmarks.gateway import _edge_node
+
+    node = _edge_node([15020, 15021, 15022], broker_port=1883)  # not started: nothing connects
+    assert node.answers_at == {"r00": [], "r01": [], "r02": []}
