@@ -17,7 +17,7 @@ import pytest
 from app import timing
 from app.connection import ConnectionSettings
 from app.link.robot_link import RobotLink
-from app.link.types import LinkState, StepFrame
+from app.link.types import LinkState
 from app.points.point import SyncState
 from app.protocol.enums import RunCommand
 from app.protocol.registers import CANARY_GV, REG_RUN_COMMAND
@@ -33,6 +33,8 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     is_state,
     project_dialogs_fixture,
     register_writes,
+    step_by_link,
+    teach_here,
     translator_fixture,
     window_fixture,
 )
@@ -77,17 +79,15 @@ def _connect(qtbot: Any, window: MainWindow, sim: Any) -> ConnectionSettings:
     return settings
 
 
-def _teach_five(qtbot: Any, window: MainWindow, sim: Any, make_client: Any) -> None:
-    """Teach P1..P5 from the Points tab, the arm stepped STEP_MM along X before each (another
-    client steps it)."""
+def _teach_five(qtbot: Any, window: MainWindow, sim: Any) -> None:
+    """Teach P1..P5 from the Points tab, the arm stepped STEP_MM along X before each (by the
+    window's link: a helper client is another master, see ``step_by_link``)."""
     window.work_tabs.setCurrentIndex(TAB_POINTS)
     assert window.points_panel.isVisible()
-    stepper = make_client(sim)
     sync = window.point_sync
     for _ in range(5):
-        assert stepper.step(StepFrame.BASE, (STEP_MM, 0, 0, 0, 0, 0), speed=200.0).ok
-        with qtbot.waitSignal(sync.pointTaught, timeout=SIGNAL_TIMEOUT_MS):
-            assert sync.teach() is not None
+        step_by_link(qtbot, window.link, STEP_MM)
+        teach_here(qtbot, sync)
     ledger = window.project.points_model.ledger
     assert ledger.ids() == [1, 2, 3, 4, 5]
     assert all(p.sync is SyncState.ON_CONTROLLER for p in ledger)
@@ -117,7 +117,7 @@ def test_connect_to_another_controller_makes_the_points_unknown_and_move_re_crea
     P1 of its own at another pose, Move to point P1."""
     first, second = sims
     _connect(qtbot, window, first)
-    _teach_five(qtbot, window, first, make_client)
+    _teach_five(qtbot, window, first)
     p1 = window.project.points_model.ledger.point(1)
     foreign = (p1.x + FOREIGN_OFFSET[0], p1.y + FOREIGN_OFFSET[1], p1.z + FOREIGN_OFFSET[2], p1.a, p1.b, p1.c)
     assert make_client(second).create_point(1, pose=foreign, wait=True).ok  # another client's P1
@@ -167,7 +167,7 @@ def test_reconnecting_to_the_same_controller_boot_keeps_the_points(
     monkeypatch.setattr(timing, "NOT_ANSWERING_DOWN_AFTER", 0.3)  # a lost link in about 1.3 s
     sim = sims[0]
     _connect(qtbot, window, sim)
-    _teach_five(qtbot, window, sim, make_client)
+    _teach_five(qtbot, window, sim)
     canary_writes = len(gv_writes(sim, CANARY_GV))
     panel = window.points_panel
 
@@ -193,7 +193,7 @@ def test_a_changed_register_profile_keeps_the_same_boot_but_not_another_unit(
     unit id (another controller behind the same address) does not."""
     sim = sim_factory(gv291="writable", unit=0)  # answers every unit id
     settings = _connect(qtbot, window, sim)
-    _teach_five(qtbot, window, sim, make_client)
+    _teach_five(qtbot, window, sim)
     for changed in (
         dataclasses.replace(settings, poll_timeout=0.9),  # the same controller and boot
         dataclasses.replace(settings, unit=2),
@@ -213,7 +213,7 @@ def test_bad_end_point_id_makes_the_point_unknown(
     answered "bad end point id", and P1 is not believed on the controller any more."""
     sim = sims[0]
     _connect(qtbot, window, sim)
-    _teach_five(qtbot, window, sim, make_client)
+    _teach_five(qtbot, window, sim)
     # the controller forgets P1 right after any create of it (here: before the move goes out)
     ProgressLog(window.link, lambda point: sim.remove_point(point.point_id))
     sim.remove_point(1)  # and before: today's Move to point sends 0x42 without creating it
@@ -236,7 +236,7 @@ def test_an_arm_that_arrives_elsewhere_is_a_failed_move_never_reached(
     there once (the stated window), and the window says the move failed, in words."""
     sim = sims[0]
     _connect(qtbot, window, sim)
-    _teach_five(qtbot, window, sim, make_client)
+    _teach_five(qtbot, window, sim)
     p1 = window.project.points_model.ledger.point(1)
     foreign = (p1.x + FOREIGN_OFFSET[0], p1.y + FOREIGN_OFFSET[1], p1.z + FOREIGN_OFFSET[2], p1.a, p1.b, p1.c)
     sim.overwrite_after_create(1, foreign)

@@ -21,7 +21,6 @@ from PySide6.QtCore import QPoint, QRect, QRectF
 from PySide6.QtGui import QTextLayout, QTextOption
 from PySide6.QtWidgets import QAbstractButton, QAbstractScrollArea, QLabel, QWidget
 
-from app.link.types import StepFrame
 from app.plan.segments import Plan, Segment
 from tests.ui.layout_audit import clipped_texts, overlapping_siblings
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -31,6 +30,8 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     fast_reconnect_fixture,
     link_fixture,
     project_dialogs_fixture,
+    step_by_link,
+    teach_here,
     translator_fixture,
 )
 from tests.ui.test_layout import (  # noqa: F401 - fixtures
@@ -204,7 +205,7 @@ def geometries(panel: PlannerPanel) -> dict[str, QRect]:
 
 @pytest.mark.parametrize("language", LANGUAGES)
 def test_the_run_box_neither_scrolls_nor_moves_after_a_stop(
-    qtbot: Any, sim: Any, make_client: Any, make_window: Callable[..., MainWindow], language: str
+    qtbot: Any, sim: Any, make_window: Callable[..., MainWindow], language: str
 ) -> None:
     """A real run at the simulator, stopped by the operator in segment 2 of loop 1 of 2."""
     from ui.dialogs.stop_first import StopFirst
@@ -212,11 +213,9 @@ def test_the_run_box_neither_scrolls_nor_moves_after_a_stop(
     window = make_window(language, LAPTOP)
     window.link_guard.ask = lambda _question: StopFirst.STOP  # the close after a stopped run asks
     window.show_tab(TAB_POINTS)
-    stepper = make_client(sim)
     for _ in range(2):  # P1, P2 taught 20 mm apart along X
-        assert stepper.step(StepFrame.BASE, (20.0, 0, 0, 0, 0, 0), speed=200.0).ok
-        with qtbot.waitSignal(window.point_sync.pointTaught, timeout=SIGNAL_TIMEOUT_MS):
-            assert window.point_sync.teach() is not None
+        step_by_link(qtbot, window.link, 20.0)
+        teach_here(qtbot, window.point_sync)
     row = window.project.plans_model.add_plan(
         Plan("slow", [Segment.line(1, 200.0), Segment.line(2, 4.0), Segment.line(1, 200.0)], loops=2)
     )

@@ -22,6 +22,8 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     fast_reconnect_fixture,
     link_fixture,
     project_dialogs_fixture,
+    step_by_link,
+    teach_here,
     translator_fixture,
     window_fixture,
 )
@@ -59,9 +61,8 @@ def test_checks_and_estimates_follow_the_pose_and_the_connection(
     window.work_tabs.setCurrentIndex(TAB_POINTS)
     stepper = make_client(sim)
     for _ in range(2):  # P1, P2 taught 20 mm apart along X; the arm ends at P2
-        assert stepper.step(StepFrame.BASE, (STEP_MM, 0, 0, 0, 0, 0), speed=200.0).ok
-        with qtbot.waitSignal(window.point_sync.pointTaught, timeout=SIGNAL_TIMEOUT_MS):
-            assert window.point_sync.teach() is not None
+        step_by_link(qtbot, window.link, STEP_MM)
+        teach_here(qtbot, window.point_sync)
     x_p2 = sim.robot.pose[0]
     plan = Plan("to P2 and back", [Segment.line(2, 200.0), Segment.line(1, 200.0)])
     window.project.plans_model.add_plan(plan)

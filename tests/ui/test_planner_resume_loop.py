@@ -10,7 +10,6 @@ from typing import Any
 
 import pytest
 
-from app.link.types import StepFrame
 from app.plan.runner import RunEvent, RunProgress, RunState
 from app.plan.segments import Plan, Segment
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -21,6 +20,8 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     fast_reconnect_fixture,
     link_fixture,
     project_dialogs_fixture,
+    step_by_link,
+    teach_here,
     translator_fixture,
     window_fixture,
 )
@@ -41,7 +42,7 @@ def _started(loop: int, index: int) -> Any:
 
 
 def test_resume_names_the_loop_and_resumes_it(
-    qtbot: Any, window: MainWindow, sim: Any, make_client: Any, translator: Any
+    qtbot: Any, window: MainWindow, sim: Any, translator: Any
 ) -> None:
     settings = connection_settings(sim, poll_timeout=1.0)
     with qtbot.waitSignal(
@@ -49,11 +50,9 @@ def test_resume_names_the_loop_and_resumes_it(
     ):
         window.connect_with(settings)
     window.work_tabs.setCurrentIndex(TAB_POINTS)
-    stepper = make_client(sim)
     for _ in range(2):  # P1, P2 taught 20 mm apart along X
-        assert stepper.step(StepFrame.BASE, (20.0, 0, 0, 0, 0, 0), speed=200.0).ok
-        with qtbot.waitSignal(window.point_sync.pointTaught, timeout=SIGNAL_TIMEOUT_MS):
-            assert window.point_sync.teach() is not None
+        step_by_link(qtbot, window.link, 20.0)
+        teach_here(qtbot, window.point_sync)
     plan = Plan("three loops", [Segment.line(1, 200.0), Segment.line(2, SLOW)], loops=3)
     row = window.project.plans_model.add_plan(plan)
     window.work_tabs.setCurrentIndex(TAB_PLANNER)

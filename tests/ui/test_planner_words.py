@@ -9,7 +9,6 @@ from typing import Any
 
 import pytest
 
-from app.link.types import StepFrame
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import Alarm
 from app.protocol.registers import REG_RUN_COMMAND
@@ -22,6 +21,8 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     link_fixture,
     project_dialogs_fixture,
     register_writes,
+    step_by_link,
+    teach_here,
     translator_fixture,
     window_fixture,
 )
@@ -34,7 +35,7 @@ STEP_MM = 20.0
 RUN_TIMEOUT_MS = 20_000
 
 
-def _two_points_and_a_plan(qtbot: Any, window: MainWindow, sim: Any, make_client: Any) -> Plan:
+def _two_points_and_a_plan(qtbot: Any, window: MainWindow, sim: Any) -> Plan:
     """P1, P2 taught 20 mm apart along X (the arm ends at P2); a plan P2 -> P1 -> P2."""
     settings = connection_settings(sim, poll_timeout=1.0)  # roomy: a loaded machine must not go silent
     with qtbot.waitSignal(
@@ -42,11 +43,9 @@ def _two_points_and_a_plan(qtbot: Any, window: MainWindow, sim: Any, make_client
     ):
         window.connect_with(settings)
     window.work_tabs.setCurrentIndex(TAB_POINTS)
-    stepper = make_client(sim)
     for _ in range(2):
-        assert stepper.step(StepFrame.BASE, (STEP_MM, 0, 0, 0, 0, 0), speed=200.0).ok
-        with qtbot.waitSignal(window.point_sync.pointTaught, timeout=SIGNAL_TIMEOUT_MS):
-            assert window.point_sync.teach() is not None
+        step_by_link(qtbot, window.link, STEP_MM)
+        teach_here(qtbot, window.point_sync)
     plan = Plan("there and back", [Segment.line(1, 200.0), Segment.line(2, 200.0)])
     plans = window.project.plans_model
     row = plans.add_plan(plan)
@@ -55,8 +54,8 @@ def _two_points_and_a_plan(qtbot: Any, window: MainWindow, sim: Any, make_client
     return plan
 
 
-def test_a_new_run_clears_plan_finished(qtbot: Any, window: MainWindow, sim: Any, make_client: Any) -> None:
-    _two_points_and_a_plan(qtbot, window, sim, make_client)
+def test_a_new_run_clears_plan_finished(qtbot: Any, window: MainWindow, sim: Any) -> None:
+    _two_points_and_a_plan(qtbot, window, sim)
     panel = window.planner_panel
     runs = window.run_controller
     with qtbot.waitSignal(runs.runFinished, timeout=RUN_TIMEOUT_MS) as finished:
@@ -70,9 +69,9 @@ def test_a_new_run_clears_plan_finished(qtbot: Any, window: MainWindow, sim: Any
 
 
 def test_no_ready_to_run_during_an_emergency_stop_in_both_languages(
-    qtbot: Any, window: MainWindow, sim: Any, make_client: Any, translator: Any
+    qtbot: Any, window: MainWindow, sim: Any, translator: Any
 ) -> None:
-    _two_points_and_a_plan(qtbot, window, sim, make_client)
+    _two_points_and_a_plan(qtbot, window, sim)
     panel = window.planner_panel
     panel.recheck()
     assert panel.summary_text == "Checks passed: ready to run"
@@ -92,10 +91,8 @@ def test_no_ready_to_run_during_an_emergency_stop_in_both_languages(
     assert panel.summary_text == "Checks passed: ready to run"
 
 
-def test_the_run_refusal_is_one_sentence_in_both_languages(
-    qtbot: Any, window: MainWindow, sim: Any, make_client: Any
-) -> None:
-    plan = _two_points_and_a_plan(qtbot, window, sim, make_client)
+def test_the_run_refusal_is_one_sentence_in_both_languages(qtbot: Any, window: MainWindow, sim: Any) -> None:
+    plan = _two_points_and_a_plan(qtbot, window, sim)
     plan.segments.append(Segment.line(42, 200.0))  # P42 does not exist: an error
     plan.segments.append(Segment.line(43, 200.0))
     panel = window.planner_panel

@@ -21,7 +21,6 @@ import pytest
 from PySide6.QtCore import Qt
 
 from app.link.robot_link import RobotLink
-from app.link.types import StepFrame
 from app.models import CommandResult
 from app.plan.segments import Plan, Segment
 from app.protocol.enums import RunCommand
@@ -33,6 +32,8 @@ from tests.ui.pendant_support import (  # noqa: F401 - fixtures
     connect,
     project_dialogs_fixture,
     register_writes,
+    step_by_link,
+    teach_here,
     translator_fixture,
     window_fixture,
 )
@@ -56,15 +57,13 @@ def link_fixture(qapp: Any) -> Iterator[RobotLink]:
     robot_link.shutdown()
 
 
-def _teach_away(qtbot: Any, window: MainWindow, sim: Any, make_client: Any) -> tuple[float, ...]:
+def _teach_away(qtbot: Any, window: MainWindow, sim: Any) -> tuple[float, ...]:
     """P1 taught 40 mm along X from here, then the arm stepped back: P1 is 40 mm away."""
     connect(qtbot, window.link, sim)
     window.work_tabs.setCurrentIndex(TAB_POINTS)
-    stepper = make_client(sim)
-    assert stepper.step(StepFrame.BASE, (40.0, 0, 0, 0, 0, 0), speed=200.0).ok
-    with qtbot.waitSignal(window.point_sync.pointTaught, timeout=SIGNAL_TIMEOUT_MS):
-        assert window.point_sync.teach() is not None
-    assert stepper.step(StepFrame.BASE, (-40.0, 0, 0, 0, 0, 0), speed=200.0).ok
+    step_by_link(qtbot, window.link, 40.0)
+    teach_here(qtbot, window.point_sync)
+    step_by_link(qtbot, window.link, -40.0)
     return tuple(sim.state().pose)
 
 
@@ -86,9 +85,9 @@ def _moves_after(sim: Any, index: int) -> list[int]:
 
 
 def test_stop_after_the_create_answer_sends_no_move_to_point(
-    qtbot: Any, window: MainWindow, sim: Any, make_client: Any
+    qtbot: Any, window: MainWindow, sim: Any
 ) -> None:
-    before = _teach_away(qtbot, window, sim, make_client)
+    before = _teach_away(qtbot, window, sim)
     mark = len(sim.writes)
     answered = _on_next_answer(window.link)
     assert window.point_sync.move_to(1, 50.0)
@@ -105,10 +104,10 @@ def test_stop_after_the_create_answer_sends_no_move_to_point(
 
 
 def test_stop_after_a_segment_create_answer_ends_the_plan_run_unmoved(
-    qtbot: Any, window: MainWindow, sim: Any, make_client: Any
+    qtbot: Any, window: MainWindow, sim: Any
 ) -> None:
     """The same gap in a plan run: the window's STOP (not the planner's) ends the run stopped."""
-    before = _teach_away(qtbot, window, sim, make_client)
+    before = _teach_away(qtbot, window, sim)
     plan = Plan("to P1", [Segment.line(1, 50.0)])
     mark = len(sim.writes)
     answered = _on_next_answer(window.link)
