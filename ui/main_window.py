@@ -30,6 +30,7 @@ under way.
 from __future__ import annotations
 
 import os
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -287,9 +288,11 @@ class MainWindow(QMainWindow):
         )
 
     def _menu_stop(self) -> None:
-        """The menu's Stop (and Esc): to the link first; the measuring only watches."""
+        """The menu's Stop (and Esc): to the link first; the measuring only watches (from the
+        moment before the Stop was sent)."""
+        clicked = time.monotonic()
         self.link.submit(Stop())
-        self.stop_timing.note_stop()
+        self.stop_timing.note_stop(clicked)
 
     @property
     def traffic_panel(self) -> TrafficPanel:  # built when its dock is first seen (WindowDocks)

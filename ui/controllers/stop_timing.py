@@ -46,25 +46,38 @@ class StopTiming(QObject):
         self._timeout = QTimer(self)  # no poll at all (a lost link): the timeout still ends it
         self._timeout.setSingleShot(True)
         self._timeout.timeout.connect(self._on_timeout)
-        control_bar.stopRequested.connect(self.note_stop)
-        jog.jogReleased.connect(self.note_jog_release)
+        # timed from the click, which the bar and the panel note before their signal: the Stop or
+        # release goes out in its first slot (the motion controller), this one hears it after
+        self._bar, self._jog = control_bar, jog
+        control_bar.stopRequested.connect(self._on_stop_button)
+        jog.jogReleased.connect(self._on_jog_released)
         state.polled.connect(self._on_polled)
 
     @Slot()
-    def note_stop(self) -> None:
-        """The operator asked for a Stop (the button, the menu, Esc): time it from now."""
-        self._start(StopKind.STOP)
+    def _on_stop_button(self) -> None:
+        self.note_stop(self._bar.stop_clicked_at)
 
     @Slot()
-    def note_jog_release(self) -> None:
-        self._start(StopKind.JOG_RELEASE)
+    def _on_jog_released(self) -> None:
+        self.note_jog_release(self._jog.released_at)
 
-    def _start(self, kind: StopKind) -> None:
+    def note_stop(self, at: float | None = None) -> None:
+        """The operator asked for a Stop (the button, the menu, Esc) at ``at`` (``time.monotonic()``,
+        noted before the Stop was sent; None: now)."""
+        self._start(StopKind.STOP, at)
+
+    def note_jog_release(self, at: float | None = None) -> None:
+        self._start(StopKind.JOG_RELEASE, at)
+
+    def _start(self, kind: StopKind, at: float | None) -> None:
         if not self._state.connected:
             return  # nothing was sent, nothing to see: not measured
         now = self._clock()
+        # the click's time, not this slot's: on a loaded machine sending the Stop (the stop line's
+        # write, its hand-off) can take milliseconds, and the arm may already rest (stop 29)
+        clicked = now if at is None or at > now else at
         age = self._state.age(now)
-        self.watch.click(kind, now, self._state.pose, None if age is None else now - age)
+        self.watch.click(kind, clicked, self._state.pose, None if age is None else now - age)
         self._timeout.start(int(self.watch.timeout * 1000) + 50)
 
     def cancel(self) -> None:

@@ -11,6 +11,8 @@ while the link is not live.
 
 from __future__ import annotations
 
+import time
+
 from PySide6.QtCore import QEvent, Qt, Signal, Slot
 from PySide6.QtGui import QFont
 from PySide6.QtWidgets import QButtonGroup, QGridLayout, QLabel, QPushButton, QSizePolicy, QWidget
@@ -62,6 +64,8 @@ class ControlBar(QWidget):
         super().__init__(parent)
         self.setObjectName("ControlBar")
         self._mode: ControllerMode | int | None = None
+        #: when the STOP button was last clicked (``time.monotonic()``), noted before stopRequested
+        self.stop_clicked_at: float | None = None
 
         self.stop_button = QPushButton(self)
         self.stop_button.setObjectName("StopButton")
@@ -75,7 +79,7 @@ class ControlBar(QWidget):
             2 * BUTTON_HEIGHT + 4,
         )
         self.stop_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
-        self.stop_button.clicked.connect(self.stopRequested)
+        self.stop_button.clicked.connect(self._on_stop_clicked)
 
         self.pause_button = QPushButton(self)
         self.resume_button = QPushButton(self)
@@ -187,6 +191,13 @@ class ControlBar(QWidget):
         """An e-stop / servo alarm holds Resume (it would restart motion); Stop and Pause stay."""
         self._alarm_hold = bool(hold)
         self.resume_button.setEnabled(self._motion_enabled and not self._alarm_hold)
+
+    @Slot()
+    def _on_stop_clicked(self) -> None:
+        # the time first: the Stop goes out in stopRequested's first slot (the motion controller),
+        # the measuring (ui/controllers/stop_timing.py) reads this time after it
+        self.stop_clicked_at = time.monotonic()
+        self.stopRequested.emit()
 
     def mode_text(self) -> str:
         """The controller's mode as shown (translated), without the caption; "" while unknown

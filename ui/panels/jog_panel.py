@@ -12,6 +12,7 @@ cancelled that way needs a fresh press: dragging back onto it does not restart t
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass
 
 from PySide6.QtCore import QEvent, QObject, Qt, Signal, Slot
@@ -142,6 +143,8 @@ class JogPanel(QWidget):
         self.setObjectName("JogPanel")
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self._held: _Held | None = None
+        #: when the jog was last let go (``time.monotonic()``), noted before jogReleased
+        self.released_at: float | None = None
         self._motion_enabled = False
         self._halt: UnconfirmedHalt | None = None  # a stop the controller has not confirmed
         self._ratio_cap: float | None = None  # the envelope's cap in force (None: no envelope)
@@ -395,7 +398,7 @@ class JogPanel(QWidget):
             button.cancel()
         if self._held is not None:
             self._held = None
-            self.jogReleased.emit()
+            self._emit_release()
 
     # --- keyboard ---------------------------------------------------------------------
     def _key_axis(self, key: int) -> tuple[int, int] | None:
@@ -464,6 +467,12 @@ class JogPanel(QWidget):
             return  # an older key let go while a newer one is held: the newer one goes on
         self._light(held, False)
         self._held = None
+        self._emit_release()
+
+    def _emit_release(self) -> None:
+        # the time first: the release goes out in jogReleased's first slot (the motion controller),
+        # the measuring (ui/controllers/stop_timing.py) reads this time after it
+        self.released_at = time.monotonic()
         self.jogReleased.emit()
 
     def _light(self, held: _Held | None, on: bool) -> None:

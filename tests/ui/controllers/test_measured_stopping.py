@@ -5,6 +5,7 @@ audit trail and the support bundle."""
 from __future__ import annotations
 
 import math
+import time
 import zipfile
 from pathlib import Path
 from typing import Any
@@ -13,7 +14,7 @@ import pytest
 from PySide6.QtCore import Qt
 
 from app import timing
-from app.link.ops import Step, Stop
+from app.link.ops import JogRelease, Step, Stop
 from app.link.types import StepFrame
 from app.safety.audit_read import query
 from app.safety.stopping import StopKind, StopMeasurement
@@ -164,3 +165,66 @@ def test_the_menus_stop_and_esc_are_measured_too(qtbot: Any, sim: Any, window: A
         result.kind is StopKind.STOP and result.still and result.seconds == 0.0 and result.distance_mm == 0.0
     )
     assert window.monitor_panel.last_stop_label.text() == "Last stop: 0 ms, 0.0 mm"
+
+
+SLOW_SEND = 0.15  # s the link takes to take a request, as on a loaded machine (the stop line's hand-off)
+
+
+def _slow_link(window: Any, monkeypatch: pytest.MonkeyPatch) -> list[tuple[float, Any]]:
+    """Every request takes SLOW_SEND to submit, as on a loaded machine; returns (when its submit
+    began, the op) for each (the motion controller sends the Stop or the release in the first slot
+    of the signal the measuring hears after it)."""
+    submit = window.link.submit
+    sent: list[tuple[float, Any]] = []
+
+    def slow(op: Any) -> int:
+        sent.append((time.monotonic(), op))
+        time.sleep(SLOW_SEND)
+        return int(submit(op))
+
+    monkeypatch.setattr(window.link, "submit", slow)
+    return sent
+
+
+def _sent_at(sent: list[tuple[float, Any]], kind: type) -> float:
+    at: float = next(at for at, op in reversed(sent) if isinstance(op, kind))
+    return at
+
+
+def test_a_stop_is_timed_from_the_click_however_long_sending_it_takes(
+    qtbot: Any, sim: Any, window: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    connect(qtbot, window.link, sim, poll_timeout=1.0)
+    window.link.submit(Step(StepFrame.BASE, (0.0, 0.0, -100.0, 0.0, 0.0, 0.0), speed=STEP_SPEED))  # 1 s
+    qtbot.waitUntil(lambda: sim.state().moving, timeout=SIGNAL_TIMEOUT_MS)
+    sent = _slow_link(window, monkeypatch)
+    result = _measured(
+        qtbot, window, lambda: qtbot.mouseClick(window.control_bar.stop_button, Qt.MouseButton.LeftButton)
+    )
+    assert result.clicked_at <= _sent_at(sent, Stop)  # from the click, not from after the Stop went out
+    assert result.clicked_at <= sim.rest_records()[-1].t  # the arm rested after the click
+
+
+def test_a_jog_release_is_timed_from_the_release_however_long_sending_it_takes(
+    qtbot: Any, sim: Any, window: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    connect(qtbot, window.link, sim, poll_timeout=1.0)
+    qtbot.waitUntil(lambda: window.jog_panel.axes_box.isEnabled(), timeout=SIGNAL_TIMEOUT_MS)
+    button = window.jog_panel.button(0, 1)
+    qtbot.mousePress(button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
+    sent = _slow_link(window, monkeypatch)
+    result = _measured(qtbot, window, lambda: qtbot.mouseRelease(button, Qt.MouseButton.LeftButton))
+    assert result.kind is StopKind.JOG_RELEASE
+    assert result.clicked_at <= _sent_at(sent, JogRelease)
+
+
+def test_the_menus_stop_is_timed_from_before_it_was_sent(
+    qtbot: Any, sim: Any, window: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    connect(qtbot, window.link, sim, poll_timeout=1.0)
+    window.link.submit(Step(StepFrame.BASE, (0.0, 0.0, -100.0, 0.0, 0.0, 0.0), speed=STEP_SPEED))  # 1 s
+    qtbot.waitUntil(lambda: sim.state().moving, timeout=SIGNAL_TIMEOUT_MS)
+    sent = _slow_link(window, monkeypatch)
+    result = _measured(qtbot, window, window._menu_stop)
+    assert result.clicked_at <= _sent_at(sent, Stop)
