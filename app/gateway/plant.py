@@ -184,6 +184,10 @@ class PlantWriter:
                 raise PlantRefused(
                     f"{self.name} did not answer within {timing.GATEWAY_PLANT_COMMAND_TTL:g} s of the command"
                 )
+            # read now: the poll's status may have been read before the command came (a poll in
+            # flight when it arrived), and another master's program started in between would be
+            # missed (a run beside busy loops: a plant Stop sent into a pendant's program)
+            status = client.read_status()
             self._check_commanded(client, status, now)
             if command.write == "speed_ratio":
                 self._set_ratio(command, client)
