@@ -191,13 +191,21 @@ def _sent_at(sent: list[tuple[float, Any]], kind: type) -> float:
     return at
 
 
-def test_a_stop_is_timed_from_the_click_however_long_sending_it_takes(
+def _moving_on_a_slow_link(
     qtbot: Any, sim: Any, window: Any, monkeypatch: pytest.MonkeyPatch
-) -> None:
+) -> list[tuple[float, Any]]:
+    """Connected, the arm stepping down (1 s), then every request slow to submit (``_slow_link``)."""
     connect(qtbot, window.link, sim, poll_timeout=1.0)
     window.link.submit(Step(StepFrame.BASE, (0.0, 0.0, -100.0, 0.0, 0.0, 0.0), speed=STEP_SPEED))  # 1 s
     qtbot.waitUntil(lambda: sim.state().moving, timeout=SIGNAL_TIMEOUT_MS)
     sent = _slow_link(window, monkeypatch)
+    return sent
+
+
+def test_a_stop_is_timed_from_the_click_however_long_sending_it_takes(
+    qtbot: Any, sim: Any, window: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    sent = _moving_on_a_slow_link(qtbot, sim, window, monkeypatch)
     result = _measured(
         qtbot, window, lambda: qtbot.mouseClick(window.control_bar.stop_button, Qt.MouseButton.LeftButton)
     )
@@ -222,9 +230,6 @@ def test_a_jog_release_is_timed_from_the_release_however_long_sending_it_takes(
 def test_the_menus_stop_is_timed_from_before_it_was_sent(
     qtbot: Any, sim: Any, window: Any, monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    connect(qtbot, window.link, sim, poll_timeout=1.0)
-    window.link.submit(Step(StepFrame.BASE, (0.0, 0.0, -100.0, 0.0, 0.0, 0.0), speed=STEP_SPEED))  # 1 s
-    qtbot.waitUntil(lambda: sim.state().moving, timeout=SIGNAL_TIMEOUT_MS)
-    sent = _slow_link(window, monkeypatch)
+    sent = _moving_on_a_slow_link(qtbot, sim, window, monkeypatch)
     result = _measured(qtbot, window, window._menu_stop)
     assert result.clicked_at <= _sent_at(sent, Stop)
