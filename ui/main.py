@@ -9,6 +9,12 @@ teachpad --sim --screenshot out.png --size 1400x900 [--tab planner]   render onc
 
 from __future__ import annotations
 
+# First: PySide (imported by whoever imports this) reads the source of none of the modules below,
+# ours nor the standard library's (ui/pyside_scan.py)
+from ui.pyside_scan import skip_source_scan
+
+skip_source_scan()
+
 import argparse
 import dataclasses
 import os
@@ -24,10 +30,8 @@ from PySide6.QtCore import QEvent, QObject, QTimer, Signal
 from PySide6.QtWidgets import QApplication, QWidget
 
 from ui.gui_gc import GuiThreadCollector
-from ui.pyside_scan import skip_source_scan
 from ui.startup_gc import StartupGcPause, gc_paused
 
-skip_source_scan()  # PySide reads the source of none of the modules below (ui/pyside_scan.py)
 with gc_paused(freeze=True):  # the window's modules: many objects made, none freed (ui/startup_gc.py)
     from app.connection import ConnectionSettings
     from app.link.ops import RunProgram

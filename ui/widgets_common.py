@@ -46,6 +46,11 @@ LEVEL_WARN = "warn"
 LEVEL_ERROR = "error"
 LEVEL_INFO = "info"
 
+#: A number shape's room (px) by (font key, integer digits, decimals): every readout of a shape
+#: measures the same font at every size the monitor tries (~130 sizes before the first paint, ten
+#: digits measured each), so the first measure of each is kept
+_number_rooms: dict[tuple[str, int, int], int] = {}
+
 _LAMP_STYLE: dict[str, tuple[str, str, str]] = {  # level -> (background, text, border)
     LEVEL_OFF: (COLOR_NEUTRAL_BG, COLOR_NEUTRAL, COLOR_BORDER),
     LEVEL_OK: (COLOR_OK, COLOR_WHITE, COLOR_OK),
@@ -264,7 +269,11 @@ class NumericReadout(QFrame):
         return font
 
     def _number_room(self, font: QFont) -> int:
-        return number_room(QFontMetrics(font), self._integer_digits, self._decimals)
+        key = (font.key(), self._integer_digits, self._decimals)
+        room = _number_rooms.get(key)
+        if room is None:
+            room = _number_rooms[key] = number_room(QFontMetrics(font), self._integer_digits, self._decimals)
+        return room
 
     def width_for(self, point_size: float) -> int:
         """The least width (px) this readout needs at ``point_size`` to show its widest number

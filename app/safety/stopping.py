@@ -26,7 +26,6 @@ from __future__ import annotations
 
 import enum
 import math
-import statistics
 from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Final
@@ -267,6 +266,8 @@ def summary_lines(measurements: Iterable[StopMeasurement]) -> list[str]:
             continue
         line = f"{kind.value}: {len(of_kind)}"
         if still:
+            import statistics  # with fractions and decimal: a report's, not the window's start (~2 ms)
+
             times = [m.seconds * 1000.0 for m in still]
             mm = [m.distance_mm for m in still]
             line += (

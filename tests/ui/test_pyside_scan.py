@@ -11,7 +11,7 @@ from pathlib import Path
 import pytest
 
 from ui import pyside_scan
-from ui.pyside_scan import own_module_names, skip_source_scan
+from ui.pyside_scan import IGNORED, USES_PYSIDE, own_module_names, skip_source_scan
 
 
 def test_the_names_are_every_module_and_package_of_app_and_ui(tmp_path: Path) -> None:
@@ -27,7 +27,7 @@ def test_the_names_are_every_module_and_package_of_app_and_ui(tmp_path: Path) ->
     (tmp_path / "app" / "__pycache__").mkdir()
     (tmp_path / "app" / "__pycache__" / "stale.py").write_text("")  # not a package: skipped
     (tmp_path / "ui" / "notes.txt").write_text("")
-    assert sorted(own_module_names(tmp_path)) == ["app", "app.link", "app.link.worker", "ui", "ui.main"]
+    assert sorted(own_module_names(str(tmp_path))) == ["app", "app.link", "app.link.worker", "ui", "ui.main"]
 
 
 def test_the_real_tree_names_the_window_and_the_link() -> None:
@@ -36,14 +36,19 @@ def test_the_real_tree_names_the_window_and_the_link() -> None:
     assert not any("__pycache__" in name for name in names)
 
 
-def test_own_modules_are_entered_once_and_others_left_alone(monkeypatch: pytest.MonkeyPatch) -> None:
-    table = {"ui.main": -1, "json": -1}  # a name already there keeps its value
+def test_own_and_standard_modules_entered_once_others_left_alone(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    table = {"ui.main": -1, "json": 0, "numpy": 0}  # a name already there keeps its value
     monkeypatch.setitem(
         sys.modules, "shibokensupport.feature", types.SimpleNamespace(pyside_feature_dict=table)
     )
     entered = skip_source_scan()
-    assert entered == len(set(own_module_names())) - 1
-    assert table["ui.main"] == -1 and table["json"] == -1 and table["app.link.robot_link"] == 0
+    assert entered == len(set(own_module_names())) - 1 + len(sys.stdlib_module_names) - 1
+    assert table["ui.main"] == -1 and table["json"] == 0 and table["numpy"] == 0
+    assert table["app.link.robot_link"] == USES_PYSIDE == 0  # what PySide's scan would say
+    assert table["typing"] == table["argparse"] == IGNORED == -1  # no standard module says "PySide6"
+    assert "pymodbus" not in table and "json.decoder" not in table  # only names it can vouch for
     assert skip_source_scan() == 0  # nothing new the second time
 
 

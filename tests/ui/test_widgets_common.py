@@ -6,9 +6,12 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from PySide6.QtGui import QFont, QFontMetrics
 from PySide6.QtWidgets import QFileDialog, QMessageBox, QWidget
 
-from ui.widgets_common import export_with_dialog
+from ui import widgets_common
+from ui.widgets.number_text import number_room
+from ui.widgets_common import NumericReadout, export_with_dialog, monospace_font
 
 
 @pytest.fixture
@@ -48,3 +51,24 @@ def test_a_failed_write_is_shown_not_raised(
     assert len(shown) == 1
     assert shown[0][0] == "Export log"
     assert shown[0][1].startswith(f"Could not write {tmp_path / 'no' / 'x.txt'}: ")
+
+
+def test_readouts_of_one_shape_share_a_measure_that_is_the_fonts(
+    qtbot: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    rooms: dict[tuple[str, int, int], int] = {}
+    monkeypatch.setattr(widgets_common, "_number_rooms", rooms)
+    x, y = NumericReadout("X", "mm"), NumericReadout("Y", "mm")
+    j1 = NumericReadout("J1", "°", decimals=2, integer_digits=3)
+    for readout in (x, y, j1):
+        qtbot.addWidget(readout)
+    for points in (8.0, 13.5, 22.0, 40.0):
+        font = monospace_font(points, bold=True)
+        for readout in (x, y, j1):
+            readout.width_for(points)
+        fresh = number_room(QFontMetrics(QFont(font)), 4, 3)  # measured now, not kept
+        assert rooms[(font.key(), 4, 3)] == fresh
+        assert rooms[(font.key(), 3, 2)] == number_room(QFontMetrics(QFont(font)), 3, 2)
+    # one measure per shape and size (the readouts' own sizes, 22 pt, among them), not one per readout
+    assert len(rooms) == 2 * 4
+    assert x._number.minimumWidth() == rooms[(monospace_font(22.0, bold=True).key(), 4, 3)]
