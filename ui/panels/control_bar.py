@@ -64,7 +64,8 @@ class ControlBar(QWidget):
         super().__init__(parent)
         self.setObjectName("ControlBar")
         self._mode: ControllerMode | int | None = None
-        #: when the STOP button was last clicked (``time.monotonic()``), noted before stopRequested
+        #: when the STOP button was clicked (``time.monotonic()``): set while stopRequested is emitted
+        #: for that click, None otherwise
         self.stop_clicked_at: float | None = None
 
         self.stop_button = QPushButton(self)
@@ -195,9 +196,13 @@ class ControlBar(QWidget):
     @Slot()
     def _on_stop_clicked(self) -> None:
         # the time first: the Stop goes out in stopRequested's first slot (the motion controller),
-        # the measuring (ui/controllers/stop_timing.py) reads this time after it
+        # the measuring (ui/controllers/stop_timing.py) reads this time after it; cleared after the
+        # signal, so a Stop asked for otherwise (the signal emitted alone) is not timed from this click
         self.stop_clicked_at = time.monotonic()
-        self.stopRequested.emit()
+        try:
+            self.stopRequested.emit()
+        finally:
+            self.stop_clicked_at = None
 
     def mode_text(self) -> str:
         """The controller's mode as shown (translated), without the caption; "" while unknown

@@ -143,7 +143,8 @@ class JogPanel(QWidget):
         self.setObjectName("JogPanel")
         self.setFocusPolicy(Qt.FocusPolicy.StrongFocus)
         self._held: _Held | None = None
-        #: when the jog was last let go (``time.monotonic()``), noted before jogReleased
+        #: when the jog was let go (``time.monotonic()``): set while jogReleased is emitted for that
+        #: release, None otherwise
         self.released_at: float | None = None
         self._motion_enabled = False
         self._halt: UnconfirmedHalt | None = None  # a stop the controller has not confirmed
@@ -471,9 +472,13 @@ class JogPanel(QWidget):
 
     def _emit_release(self) -> None:
         # the time first: the release goes out in jogReleased's first slot (the motion controller),
-        # the measuring (ui/controllers/stop_timing.py) reads this time after it
+        # the measuring (ui/controllers/stop_timing.py) reads this time after it; cleared after the
+        # signal (see ControlBar._on_stop_clicked)
         self.released_at = time.monotonic()
-        self.jogReleased.emit()
+        try:
+            self.jogReleased.emit()
+        finally:
+            self.released_at = None
 
     def _light(self, held: _Held | None, on: bool) -> None:
         """A key jog shows its button pressed while the key is held (the mouse does that itself)."""

@@ -233,3 +233,30 @@ def test_the_menus_stop_is_timed_from_before_it_was_sent(
     sent = _moving_on_a_slow_link(qtbot, sim, window, monkeypatch)
     result = _measured(qtbot, window, window._menu_stop)
     assert result.clicked_at <= _sent_at(sent, Stop)
+
+
+def test_a_stop_asked_for_without_a_click_is_not_timed_from_an_earlier_click(
+    qtbot: Any, sim: Any, window: Any
+) -> None:
+    connect(qtbot, window.link, sim, poll_timeout=1.0)
+    bar = window.control_bar
+    first = _measured(qtbot, window, lambda: qtbot.mouseClick(bar.stop_button, Qt.MouseButton.LeftButton))
+    assert bar.stop_clicked_at is None  # the click's time lived while its signal was out
+    before = time.monotonic()
+    second = _measured(qtbot, window, bar.stopRequested.emit)  # a Stop asked for some other way
+    assert second.kind is StopKind.STOP
+    assert second.clicked_at >= before > first.clicked_at  # timed from now, not from that click
+
+
+def test_a_jog_release_time_is_its_own(qtbot: Any, sim: Any, window: Any) -> None:
+    connect(qtbot, window.link, sim, poll_timeout=1.0)
+    qtbot.waitUntil(lambda: window.jog_panel.axes_box.isEnabled(), timeout=SIGNAL_TIMEOUT_MS)
+    button = window.jog_panel.button(0, 1)
+    qtbot.mousePress(button, Qt.MouseButton.LeftButton)
+    qtbot.waitUntil(lambda: jogging(sim), timeout=SIGNAL_TIMEOUT_MS)
+    first = _measured(qtbot, window, lambda: qtbot.mouseRelease(button, Qt.MouseButton.LeftButton))
+    assert first.kind is StopKind.JOG_RELEASE
+    assert window.jog_panel.released_at is None
+    before = time.monotonic()
+    second = _measured(qtbot, window, window.jog_panel.jogReleased.emit)
+    assert second.clicked_at >= before > first.clicked_at
