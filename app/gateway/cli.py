@@ -29,6 +29,7 @@ from app.errors import TeachPadError
 from app.gateway.bdseq import default_bdseq_file
 from app.gateway.edge_node import BrokerSettings, EdgeNode
 from app.gateway.poller import GatewayTiming
+from app.stop_signals import SignalNote
 from app.version import VersionAction
 
 PROG = "teachpad-gateway"
@@ -180,13 +181,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except (UsageError, TeachPadError) as exc:  # TeachPadError: the cell file, or the envelope
         print(f"{PROG}: {exc}", file=sys.stderr)
         return EXIT_USAGE
-    done = threading.Event()
-    reload = threading.Event()
-    for sig in (signal.SIGINT, signal.SIGTERM):
-        signal.signal(sig, lambda *_: done.set())
-    hangup = getattr(signal, "SIGHUP", None)  # none on Windows: the cell file is read at start only
-    if hangup is not None:
-        signal.signal(hangup, lambda *_: reload.set())
+    stop, reload = _signal_notes()
     edge.start()
     print(
         f"{PROG}: {len(cell.controllers)} controller(s) of cell {cell.name!r} -> {broker.host}:{broker.port} "
@@ -194,12 +189,20 @@ def main(argv: Sequence[str] | None = None) -> int:
         file=sys.stderr,
         flush=True,
     )
-    while not done.wait(RELOAD_CHECK):
-        if reload.is_set():
-            reload.clear()
+    while not stop.wait(RELOAD_CHECK):
+        if reload.take():
             _reload(edge, args.cell)
     _stop(edge)
     return 0
+
+
+def _signal_notes() -> tuple[SignalNote, SignalNote]:
+    """Ctrl-C and SIGTERM (stop), SIGHUP (read the cell file again; none on Windows: read at start
+    only), noted by handlers that take no lock (app/stop_signals.py: ``done.set()`` in a handler
+    could wait forever for the lock of the Event the main loop was waiting on)."""
+    hangup = getattr(signal, "SIGHUP", None)
+    stop = SignalNote((signal.SIGINT, signal.SIGTERM)).install()
+    return stop, SignalNote((hangup,) if hangup is not None else ()).install()
 
 
 def _stop(edge: EdgeNode) -> None:

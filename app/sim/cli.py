@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import logging
 import os
-import signal
 import sys
 import threading
 from collections.abc import Callable, Sequence
@@ -20,6 +19,7 @@ from app.sim.config import GV291_MODES, TIMING_PROFILES, SimConfig
 from app.sim.fleet import SimFleet
 from app.sim.guard import WATCHDOG_TIMEOUT
 from app.sim.server import SimController
+from app.stop_signals import SignalNote, stop_signals
 from app.version import VersionAction
 
 log = logging.getLogger(__name__)
@@ -282,7 +282,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if fleet is None:
         return 1
     done = threading.Event()
-    previous = _stop_on_signals(done)
+    stop = _stop_on_signals()
     # Announced only now: whoever waits for this line may stop us at once (SIGTERM), and before
     # the handler exists that would kill the process instead of stopping it cleanly.
     for sim in fleet:
@@ -294,14 +294,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     if not args.no_stdin:
         threading.Thread(target=_read_commands, args=(fleet, done), name="sim-stdin", daemon=True).start()
     try:
-        while not done.wait(0.2):
+        while not stop.wait(0.2, done):
             pass
     except KeyboardInterrupt:
         pass
     finally:
         fleet.stop()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)  # type: ignore[arg-type]
+        stop.restore()
+    if stop.signum is not None:
+        log.info("signal %d: stopped", stop.signum)
     _say("teachpad-sim stopped")
     return 0
 
@@ -379,27 +380,10 @@ def _read_commands(fleet: SimFleet, done: threading.Event) -> None:
     done.set()
 
 
-def _stop_on_signals(done: threading.Event) -> dict[signal.Signals, object]:
-    """Handlers that set ``done`` on the stop signals (main thread only: elsewhere Python cannot
-    install them); the handlers they replace, to put back at the end."""
-    previous: dict[signal.Signals, object] = {}
-    if threading.current_thread() is threading.main_thread():
-
-        def on_signal(signum: int, _frame: object) -> None:
-            log.info("signal %d: stopping", signum)
-            done.set()
-
-        for sig in _stop_signals():
-            previous[sig] = signal.signal(sig, on_signal)
-    return previous
-
-
-def _stop_signals() -> tuple[signal.Signals, ...]:
-    """The signals that stop the simulator cleanly: Ctrl-C and SIGTERM (``terminate()`` on POSIX;
-    on Windows ``terminate()`` is TerminateProcess, which no handler sees), plus Ctrl-Break on
-    Windows (SIGBREAK, the console's other stop key)."""
-    ctrl_break: signal.Signals | None = getattr(signal, "SIGBREAK", None)
-    return (signal.SIGINT, signal.SIGTERM) + ((ctrl_break,) if ctrl_break is not None else ())
+def _stop_on_signals() -> SignalNote:
+    """Ctrl-C and SIGTERM noted for the main loop (app/stop_signals.py: the handler takes no lock);
+    installed from the main thread only (elsewhere Python cannot install a handler)."""
+    return SignalNote(stop_signals()).install()
 
 
 def _wait_for_end_of_stdin(done: threading.Event) -> None:

@@ -6,13 +6,13 @@ request are printed when it stops."""
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
 import threading
 from collections.abc import Callable
 from pathlib import Path
 
 from app.sim.replay import ReplayBook, ReplayError, ReplayServer, read_capture
+from app.stop_signals import SignalNote
 
 __all__ = ["run_replay"]
 
@@ -22,7 +22,7 @@ LISTED = 50
 
 def run_replay(
     args: argparse.Namespace,
-    stop_on_signals: Callable[[threading.Event], dict[signal.Signals, object]],
+    stop_on_signals: Callable[[], SignalNote],
     say: Callable[[str], None],
     wait_for_end_of_stdin: Callable[[threading.Event], None],
 ) -> int:
@@ -40,7 +40,7 @@ def run_replay(
         print(f"teachpad-sim: {exc}", file=sys.stderr)
         return 1
     done = threading.Event()
-    previous = stop_on_signals(done)
+    stop = stop_on_signals()
     say(
         f"teachpad-sim replaying {Path(args.replay).name} ({len(exchanges)} captured requests) on "
         f"{server.endpoint}; Ctrl-C to stop"
@@ -50,14 +50,13 @@ def run_replay(
     elif args.stop_with_stdin:
         threading.Thread(target=wait_for_end_of_stdin, args=(done,), daemon=True).start()
     try:
-        while not done.wait(0.2):
+        while not stop.wait(0.2, done):
             pass
     except KeyboardInterrupt:
         pass
     finally:
         server.stop()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)  # type: ignore[arg-type]
+        stop.restore()
     for line in report_lines(book):
         say(line)
     return 0

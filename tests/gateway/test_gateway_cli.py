@@ -15,7 +15,7 @@ from typing import Any
 import pytest
 
 from app.gateway import payload as pb
-from app.gateway.cli import main
+from app.gateway.cli import _signal_notes, main
 from app.gateway.metrics import METRIC_INDEX, PLANT_RESULT, device_alias
 from tests.waits import kill_child, read_line, wait_child
 
@@ -215,3 +215,22 @@ def test_a_stop_that_does_not_end_still_ends_the_process_and_says_where_it_hung(
     assert took < 5.0  # bounded (0.2 s asked; generous for a loaded machine)
     assert "the stop did not end within 0.2 s" in err
     assert "--- thread gateway-stop" in err and "release.wait(30)" in err  # where it hung
+
+
+@pytest.mark.skipif(sys.platform == "win32", reason="POSIX signals")
+def test_its_stop_and_reload_signals_are_noted_without_a_lock() -> None:
+    """The handlers only count (app/stop_signals.py, tests/test_stop_signals.py): `done.set()` in a
+    handler could wait forever for the lock of the Event the main loop was waiting on."""
+    before = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    stop, reload = _signal_notes()
+    try:
+        assert signal.getsignal(signal.SIGTERM) == signal.getsignal(signal.SIGINT) == stop._note
+        assert signal.getsignal(signal.SIGHUP) == reload._note
+        os.kill(os.getpid(), signal.SIGHUP)
+        assert not stop.wait(0.01) and reload.take()
+        os.kill(os.getpid(), signal.SIGTERM)
+        assert stop.wait(0.01) and stop.signum == signal.SIGTERM
+    finally:
+        stop.restore()
+        reload.restore()
+    assert {sig: signal.getsignal(sig) for sig in before} == before
