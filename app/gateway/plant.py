@@ -164,8 +164,7 @@ class PlantWriter:
                 if not self._queue:
                     return
                 command = self._queue.popleft()
-            self._make(command, client, status, pose, now)
-            status = client.last_status or status  # a command reads the status again
+            self._make(command, client, pose, now)  # it reads the status itself
 
     def _follow(self, status: ControllerStatus, pose: Pose, now: float) -> None:
         if self._following is None:
@@ -176,9 +175,7 @@ class PlantWriter:
             self._following = None
             self._say(command, result.message)
 
-    def _make(
-        self, command: PlantCommand, client: RobotClient, status: ControllerStatus, pose: Pose, now: float
-    ) -> None:
+    def _make(self, command: PlantCommand, client: RobotClient, pose: Pose, now: float) -> None:
         try:
             if now - command.received > timing.GATEWAY_PLANT_COMMAND_TTL:
                 raise PlantRefused(
