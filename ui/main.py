@@ -43,6 +43,7 @@ with gc_paused(freeze=True):  # the window's modules: many objects made, none fr
     from ui.i18n import LANGUAGE_NAMES, Translator
     from ui.main_window import TAB_NAMES, MainWindow
     from ui.settings import APPLICATION, ORGANIZATION, AppSettings
+    from ui.text_fit import defer_other_languages, measure_other_languages
 
 if TYPE_CHECKING:  # subprocess and queue: imported when a simulator is started (--sim)
     import subprocess
@@ -426,6 +427,7 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
     connection = _command_line_connection(args, settings)
 
     link = RobotLink(poll_hz=args.poll_hz or settings.poll_hz)
+    defer_other_languages(translator.language)  # their fonts: measured after the first paint
     window = MainWindow(link, settings, translator)
     _arrange(window, args)
     exit_loop = _LoopExit(app)
@@ -438,6 +440,7 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
 
     def after_first_paint() -> None:
         collector.start()
+        measure_other_languages()  # the widths that fit every language (ui/text_fit.py)
         # The link's worker (pymodbus, the envelope) is made by the connection, after the paint.
         if connection is not None:
             link.connect_to(connection)
@@ -450,6 +453,7 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
     try:
         code = exit_loop.exec()
     finally:
+        measure_other_languages(refit=False)  # (a window closed before its first paint)
         _close_down(window, link, translator, collector, shot=shot, starter=starter)
     return int(code)
 

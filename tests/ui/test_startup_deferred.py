@@ -81,6 +81,7 @@ def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint
                     self.seen = sorted(m for m in DEFERRED if m in sys.modules)
                     self.seen += sorted(c for c in DEFERRED_QT if c in vars(PySide6.QtWidgets))
                     self.gc_at_paint = gc.isenabled()
+                    self.languages_at_paint = sorted(sys.modules["ui.text_fit"]._translators)
                     QTimer.singleShot(50, self._report)
                 super().paintEvent(event)
 
@@ -89,6 +90,8 @@ def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint
                                                gc.get_freeze_count() > 0]), flush=True)
                 imported = [frozen_after_import, own_scanned, standard_scanned]
                 print("IMPORT " + json.dumps(imported), flush=True)
+                languages = [self.languages_at_paint, sorted(sys.modules["ui.text_fit"]._translators)]
+                print("LANGUAGES " + json.dumps(languages), flush=True)
                 QApplication.instance().exit(0)
 
         teachpad.MainWindow = Probe
@@ -128,6 +131,8 @@ def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint
     assert set(own_scanned) <= SCANNED_BEFORE, own_scanned
     # nor of the standard modules it imports after Qt (~55 read before: typing, inspect, argparse, ...)
     assert set(standard_scanned) <= STANDARD_SCANNED_BEFORE, standard_scanned
+    # an English window's widths for Chinese (its fonts) are measured after the paint (ui/text_fit.py)
+    assert lines["LANGUAGES"] == [[], ["zh_CN"]]
 
 
 def test_a_pause_resumes_once_and_only_a_collector_that_was_on() -> None:

@@ -28,7 +28,7 @@ from app.protocol.enums import (
     controller_mode_text,
 )
 from ui.i18n import protocol_text
-from ui.text_fit import both_languages, fit_width
+from ui.text_fit import both_languages, fit_in_every_language, fit_width
 
 STOP_STYLE = (
     "QPushButton { background-color: #c62828; color: white;"
@@ -75,10 +75,6 @@ class ControlBar(QWidget):
         stop_font.setPixelSize(STOP_PIXELS)
         stop_font.setBold(True)
         self.stop_button.setFont(stop_font)
-        self.stop_button.setFixedSize(
-            max(STOP_MIN_WIDTH, fit_width(self.stop_button, both_languages("ControlBar", "STOP"), 28)),
-            2 * BUTTON_HEIGHT + 4,
-        )
         self.stop_button.setFocusPolicy(Qt.FocusPolicy.NoFocus)
         self.stop_button.clicked.connect(self._on_stop_clicked)
 
@@ -97,7 +93,7 @@ class ControlBar(QWidget):
         mode_font.setBold(True)
         self.mode_label.setFont(mode_font)
         self.mode_label.setAlignment(Qt.AlignmentFlag.AlignCenter)
-        self.mode_label.setFixedSize(self._mode_badge_width(), 2 * BUTTON_HEIGHT + 4)
+        fit_in_every_language(self._fix_widths)
         self.manual_button = QPushButton(self)
         self.auto_button = QPushButton(self)
         self._mode_group = QButtonGroup(self)
@@ -211,6 +207,12 @@ class ControlBar(QWidget):
         return "" if mode is None else protocol_text(controller_mode_text(int(mode)))
 
     # --- internals --------------------------------------------------------------------
+    def _fix_widths(self) -> None:
+        """The STOP button and the mode badge as wide as their widest text in every language."""
+        stop_width = fit_width(self.stop_button, both_languages("ControlBar", "STOP"), 28)
+        self.stop_button.setFixedSize(max(STOP_MIN_WIDTH, stop_width), 2 * BUTTON_HEIGHT + 4)
+        self.mode_label.setFixedSize(self._mode_badge_width(), 2 * BUTTON_HEIGHT + 4)
+
     def _mode_badge_width(self) -> int:
         """The widest caption or mode word in every language, within MODE_MAX_WIDTH."""
         texts = [*both_languages("ControlBar", "Mode:"), *both_languages("ControlBar", "unknown")]

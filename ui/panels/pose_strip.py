@@ -51,7 +51,7 @@ from ui.palette import (
     COLOR_WARN,
     COLOR_WHITE,
 )
-from ui.text_fit import both_languages, fit_width
+from ui.text_fit import both_languages, fit_in_every_language, fit_width
 from ui.widgets.number_text import fit_number, number_room, number_text
 from ui.widgets_common import monospace_font
 
@@ -142,7 +142,6 @@ class PoseStrip(QFrame):
             value.setAutoFillBackground(True)
             unit = QLabel(self)
             unit.setStyleSheet(f"color: {COLOR_NEUTRAL};")
-            unit.setFixedWidth(fit_width(unit, [*both_languages("PoseStrip", "mm"), "°"], padding=2))
             self.captions[name], self.values[name], self.units[name] = caption, value, unit
             layout.addWidget(caption)
             layout.addWidget(value)
@@ -160,7 +159,7 @@ class PoseStrip(QFrame):
             chip.setAlignment(Qt.AlignmentFlag.AlignCenter)
         for caption_label in (self.mode_caption, self.program_caption):
             caption_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
-        self._fix_widths()
+        fit_in_every_language(self._fix_widths)
         for widget in (
             self.mode_caption,
             self.mode_chip,
@@ -197,6 +196,9 @@ class PoseStrip(QFrame):
         super().resizeEvent(event)
 
     def _fix_widths(self) -> None:
+        units = [*both_languages("PoseStrip", "mm"), "°"]
+        for unit in self.units.values():
+            unit.setFixedWidth(fit_width(unit, units, padding=2))
         # an undocumented mode code ("unknown status 7") is rare: it elides, the tooltip has it
         proto = [t for text in CONTROLLER_MODE_TEXT.values() for t in both_languages(TR_CONTEXT, text)]
         unknown = both_languages(CTX, _UNKNOWN)
