@@ -103,6 +103,8 @@ class MonitorPanel(QWidget):
 
         self._clock = clock if clock is not None else DisplayClock.shared()
         self._shown = False  # between showEvent and hideEvent: frames are taken
+        self._fitted = False  # the readouts fitted to the panel's width once (resizeEvent)
+        self._fit_scheduled = False
         self._build_ui()
 
     # --- UI ---------------------------------------------------------------------------
@@ -487,8 +489,20 @@ class MonitorPanel(QWidget):
         return readout_scale(width)
 
     def resizeEvent(self, event: QResizeEvent) -> None:
-        self._readout_boxes.fit_width(event.size().width())  # numbers as big as the panel allows
+        if self._fitted:
+            self._fit_readouts()
+        elif not self._fit_scheduled:
+            # Qt lays a window out twice in its first show() (this panel ~740 px wide, then as wide
+            # as the docks leave it): the first fit waits for the loop, which comes back before the
+            # first paint, and is made once, at the width of then (~10 ms less before the paint)
+            self._fit_scheduled = True
+            QTimer.singleShot(0, self, self._fit_readouts)
         super().resizeEvent(event)
+
+    @Slot()
+    def _fit_readouts(self) -> None:
+        self._fitted = True
+        self._readout_boxes.fit_width(self.width())  # numbers as big as the panel allows
 
     # --- frames follow visibility --------------------------------------------------------
     def showEvent(self, event: QShowEvent) -> None:

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 import pytest
 from PySide6.QtCore import QCoreApplication, QTranslator
+from PySide6.QtWidgets import QWidget
 
 from app.models import Pose
 from ui.panels import monitor_panel
@@ -275,3 +276,27 @@ def test_non_finite_samples_stay_out_of_the_plots(panel: MonitorPanel) -> None:
     assert panel.sample_count == 1
     assert panel.readouts["X"].text() == "—"
     assert panel.readouts["Y"].text() == "0.000"
+
+
+def test_the_first_fit_waits_for_the_loop_and_is_made_once_at_the_last_width(
+    qtbot: Any, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Qt lays a window out twice in its first show(): the readouts are fitted once, at the width
+    the panel has when the loop is back (before the first paint), then at every resize at once."""
+    host = QWidget()
+    qtbot.addWidget(host)
+    host.resize(1400, 600)
+    panel = MonitorPanel(host)
+    boxes = panel._readout_boxes
+    fitted: list[int] = []
+    fit = boxes.fit_width
+    monkeypatch.setattr(boxes, "fit_width", lambda width: fitted.append(width) or fit(width))
+    panel.resize(739, 500)
+    host.show()  # the pending resize is delivered here
+    panel.resize(590, 500)  # a child: its resize event at once
+    assert fitted == []
+    qtbot.waitUntil(lambda: fitted == [590], timeout=2000)
+    big = panel.readouts["X"].point_size()
+    panel.resize(1230, 500)
+    assert fitted == [590, 1230]  # from then on, at once
+    assert panel.readouts["X"].point_size() > big
