@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 from PySide6.QtCore import QEvent, QObject, QTimer, Signal
 from PySide6.QtWidgets import QApplication, QWidget
 
+from ui.first_paint import AfterFirstPaint
 from ui.gui_gc import GuiThreadCollector
 from ui.startup_gc import StartupGcPause, gc_paused
 
@@ -229,29 +230,6 @@ class _SimStarter(QObject):
             self._thread.join(timeout)
 
 
-class _AfterFirstPaint(QObject):
-    """Runs ``callback`` once, on the event-loop turn after ``window``'s first paint: start-up
-    work the first paint does not need (opening the last project: 0.2 s for 10,000 points, a
-    recovery question) comes after the window is on screen."""
-
-    def __init__(self, window: QWidget, callback: Callable[[], object]) -> None:
-        super().__init__(window)
-        self._window = window
-        self._callback: Callable[[], object] | None = callback
-        window.installEventFilter(self)
-
-    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
-        if watched is self._window and event.type() == QEvent.Type.Paint and self._callback is not None:
-            self._window.removeEventFilter(self)
-            QTimer.singleShot(0, self._run)
-        return False
-
-    def _run(self) -> None:
-        callback, self._callback = self._callback, None
-        if callback is not None:
-            callback()
-
-
 def _size(text: str) -> tuple[int, int]:
     try:
         width, height = (int(v) for v in text.lower().split("x"))
@@ -447,7 +425,7 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
         # A screenshot run never stops on a question: it opens only what it was given.
         _start_session(window, args.project, shot_run=bool(args.screenshot))
 
-    _AfterFirstPaint(window, after_first_paint)
+    AfterFirstPaint(window, after_first_paint)
     QTimer.singleShot(STARTUP_GC_LATEST_MS, collector, collector.start)  # a window never painted
     window.show()
     try:

@@ -232,6 +232,8 @@ def window_fixture(
     qtbot.waitExposed(main_window)
     main_window.activateWindow()
     qtbot.waitActive(main_window)
+    # as once painted: a fresh install's envelope saved and audited (ui/controllers/safety.py)
+    qtbot.waitUntil(lambda: not main_window.safety_menu.safety.fresh_unsaved, timeout=5000)
     return main_window
 
 

@@ -10,40 +10,7 @@ import textwrap
 from pathlib import Path
 from typing import Any
 
-from PySide6.QtCore import QEvent, QObject
-from PySide6.QtWidgets import QWidget
-
-from ui.main import _AfterFirstPaint
-
 ROOT = Path(__file__).resolve().parents[2]
-
-
-class _Paints(QObject):
-    def __init__(self) -> None:
-        super().__init__()
-        self.count = 0
-
-    def eventFilter(self, _watched: QObject, event: QEvent) -> bool:
-        if event.type() == QEvent.Type.Paint:
-            self.count += 1
-        return False
-
-
-def test_the_callback_runs_once_after_the_first_paint(qtbot: Any) -> None:
-    widget = QWidget()
-    qtbot.addWidget(widget)
-    paints = _Paints()
-    widget.installEventFilter(paints)
-    seen: list[int] = []
-    _AfterFirstPaint(widget, lambda: seen.append(paints.count))
-    assert seen == []  # nothing before the window is shown
-    widget.resize(200, 200)
-    widget.show()
-    qtbot.waitUntil(lambda: bool(seen), timeout=5000)
-    assert seen[0] >= 1  # the window had painted when it ran
-    widget.update()
-    qtbot.waitUntil(lambda: paints.count > seen[0], timeout=5000)
-    assert len(seen) == 1
 
 
 def test_nothing_heavy_is_imported_before_the_first_paint(tmp_path: Any) -> None:

@@ -189,7 +189,7 @@ def test_a_fresh_install_checks_the_robot_models_joint_limits_and_a_keep_in_box(
     assert env.keep_in is not None
     assert env.keep_in.lo == (-1400.0, -1400.0, 0.0) and env.keep_in.hi == (1400.0, 1400.0, 1400.0)
     assert model.reach <= 1400.0  # the box is the model's reach, rounded out; Z from its base up
-    saved = load_profile(safety.profile_path)  # saved at once: every later start reads it
+    saved = load_profile(safety.profile_path)  # saved once painted: every later start reads it
     assert saved.envelope == env and saved.revision == 1 and saved.robot == model.name
     safety.session.audit.close()
     assert [r.command for r in query(safety.audit_dir) if r.kind == "action"] == [

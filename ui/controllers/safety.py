@@ -21,7 +21,8 @@
   client caps every speed it writes (jog, program, steps, moves, plan segments) and refuses go to
   zero; ``capsChanged`` tells the panels that show the cap where the speed is set.
 * **A fresh install** (no envelope file yet) starts with :func:`~app.safety.profile.
-  fresh_profile`: the robot model's joint limits and a keep-in box from its reach, on.
+  fresh_profile`: the robot model's joint limits and a keep-in box from its reach, on; in force at
+  once, saved (revision 1) and audited after the window's first paint.
 * **Audit**: the link's :class:`~app.safety.audit.AuditLog` follows the role in force.
 
 Files: where :func:`~app.safety.location.safety_location` says (machine-wide when an administrator
@@ -58,6 +59,7 @@ if TYPE_CHECKING:  # the robot model is read by its first use (a fresh install, 
     from app.view3d.profile import RobotProfile
 
 IDLE_POLL_MS = 1000
+FRESH_SAVE_LATEST_MS = 5000  # a fresh install's envelope is saved then, even with no paint yet
 _TOUCH_EVENTS = (
     QEvent.Type.MouseButtonPress,
     QEvent.Type.KeyPress,
@@ -147,8 +149,12 @@ class SafetyController(QObject):
             except TeachPadError as exc:
                 self._problem = str(exc)
         self.session = SafetySession(roles, audit, self.profile.envelope, on_role_changed=self._role_changed)
+        # A fresh install's envelope is in force from here; its file and its audit record wait for
+        # the window's first paint (install_safety; ~10 ms: a file synced, the audit's hashing) or
+        # FRESH_SAVE_LATEST_MS, whichever comes first, and for nothing else that saves an envelope.
+        self._fresh_unsaved = fresh
         if fresh:
-            self._save_fresh()
+            QTimer.singleShot(FRESH_SAVE_LATEST_MS, self, self.save_fresh_envelope)
         self._gated: list[tuple[QAction | QWidget, Action]] = []
         self._panels: list[tuple[EditGated, Action]] = []
         self._views: list[EnvelopeView] = []
@@ -176,14 +182,24 @@ class SafetyController(QObject):
         self._watch_windows()
         self._push_guard()
 
-    def _save_fresh(self) -> None:
-        """A fresh install's envelope (the robot model's defaults) is saved at once, audited: it is
-        the envelope in force, revision 1, read by every later start."""
+    @property
+    def fresh_unsaved(self) -> bool:
+        """A fresh install's envelope, in force, not saved yet (:meth:`save_fresh_envelope`)."""
+        return self._fresh_unsaved
+
+    @Slot()
+    def save_fresh_envelope(self) -> None:
+        """A fresh install's envelope (the robot model's defaults) saved and audited, once: it is
+        the envelope in force, revision 1, read by every later start. Nothing when none waits."""
+        if not self._fresh_unsaved:
+            return
+        self._fresh_unsaved = False
         try:
             self.profile_path.parent.mkdir(parents=True, exist_ok=True)
             self.profile = save_profile(self.profile_path, self.profile)
         except (OSError, TeachPadError) as exc:  # it applies all the same; say that it is not saved
             self._problem = f"the default safety envelope could not be saved in {self.profile_path}: {exc}"
+            self.message.emit(self._problem)
             return
         self.session.audit.record(
             "action",
@@ -330,6 +346,7 @@ class SafetyController(QObject):
 
     def save_envelope(self, envelope: Envelope) -> SafetyProfile:
         """Set (role checked, audited) and save the profile atomically with its next revision."""
+        self.save_fresh_envelope()  # a fresh install's first (revision 1), when it still waits
         self.session.set_envelope(envelope)
         self.profile = save_profile(
             self.profile_path, SafetyProfile(self.profile.robot, envelope, self.profile.revision)

@@ -32,6 +32,7 @@ from app.safety.register_profile import RegisterProfile
 from app.safety.roles import Action, Role
 from app.safety.session import PermissionRefused
 from ui.controllers.safety import SafetyController
+from ui.first_paint import AfterFirstPaint
 
 if TYPE_CHECKING:  # types only (the dialogs and the lazily built panels are imported when opened
     # or built: the window's first paint does not wait for them)
@@ -357,6 +358,8 @@ def attach_view3d(safety: SafetyController, panel: View3DPanel) -> None:
 def install_safety(parts: SafetyParts, *, scrypt_n: int | None = None) -> SafetyMenu:
     """Compose the guard rails onto ``parts`` (the 3D view already installed)."""
     safety = SafetyController(parts.link, parent=parts.host, scrypt_n=scrypt_n)
+    if safety.fresh_unsaved:  # a fresh install's envelope: saved and audited after the first paint
+        AfterFirstPaint(parts.host, safety.save_fresh_envelope)
     safety.set_poll_rate(parts.settings.poll_hz)  # the jog guard's margin follows the poll period
     menu = SafetyMenu(parts, safety)
     safety.gate(parts.connect_action, Action.CONNECTION)

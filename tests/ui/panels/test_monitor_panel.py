@@ -290,7 +290,12 @@ def test_the_first_fit_waits_for_the_loop_and_is_made_once_at_the_last_width(
     boxes = panel._readout_boxes
     fitted: list[int] = []
     fit = boxes.fit_width
-    monkeypatch.setattr(boxes, "fit_width", lambda width: fitted.append(width) or fit(width))
+
+    def noted_fit(width: int) -> None:
+        fitted.append(width)
+        fit(width)
+
+    monkeypatch.setattr(boxes, "fit_width", noted_fit)
     panel.resize(739, 500)
     host.show()  # the pending resize is delivered here
     panel.resize(590, 500)  # a child: its resize event at once
