@@ -14,7 +14,7 @@ from PySide6.QtCore import QObject, Signal, Slot
 from app.link.robot_link import RobotLink
 from app.link.types import ConnectionState, LinkState
 from app.models import Pose
-from app.protocol.word_order_check import WordOrderVerdict, judge_pose
+from app.protocol.word_order_check import WordOrderVerdict, is_pose, judge_pose
 
 __all__ = ["WordOrderWatch"]
 
@@ -39,6 +39,9 @@ class WordOrderWatch(QObject):
         settings = self._link.settings
         if self.verdict is not None or settings is None:
             return
+        if is_pose((*pose.xyzabc, *pose.ext)):
+            return  # read as a pose: not swapped, whatever the other order would make of it (the
+            # other order is decoded only for a read that is not a pose: ~60 us less a poll)
         verdict = judge_pose(pose, settings.word_order)
         if verdict.swapped:
             self.verdict = verdict
