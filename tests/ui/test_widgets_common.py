@@ -6,10 +6,13 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from PySide6.QtGui import QFont, QFontMetrics
-from PySide6.QtWidgets import QFileDialog, QMessageBox, QWidget
+from PySide6.QtGui import QFont, QFontMetrics, QPalette
+from PySide6.QtWidgets import QFileDialog, QLabel, QMessageBox, QWidget
 
 from ui import widgets_common
+from ui.palette import COLOR_NEUTRAL
+from ui.panels.jog_panel import JogPanel
+from ui.panels.pose_strip import PoseStrip
 from ui.widgets.number_text import number_room
 from ui.widgets_common import NumericReadout, export_with_dialog, monospace_font
 
@@ -72,3 +75,22 @@ def test_readouts_of_one_shape_share_a_measure_that_is_the_fonts(
     # one measure per shape and size (the readouts' own sizes, 22 pt, among them), not one per readout
     assert len(rooms) == 2 * 4
     assert x._number.minimumWidth() == rooms[(monospace_font(22.0, bold=True).key(), 4, 3)]
+
+
+def test_captions_and_units_are_neutral_by_palette_in_every_state(qtbot: Any) -> None:
+    """Captions and units take COLOR_NEUTRAL from their palette, not from a style sheet of their
+    own (each such label was styled by Qt's style-sheet style in the window's first show): the
+    readouts', the pose strip's, the jog panel's hints; disabled (stale) as enabled."""
+    readout = NumericReadout("X", "mm")
+    strip = PoseStrip()
+    jog = JogPanel()
+    for widget in (readout, strip, jog):
+        qtbot.addWidget(widget)
+    labels: list[QLabel] = [readout._caption, readout._unit, jog.external_caption, jog.keys_label]
+    labels += [*strip.captions.values(), *strip.units.values(), strip.mode_caption, strip.program_caption]
+    readout.setEnabled(False)
+    strip.setEnabled(False)
+    for label in labels:
+        assert label.styleSheet() == "", label.text()
+        for group in (QPalette.ColorGroup.Active, QPalette.ColorGroup.Inactive, QPalette.ColorGroup.Disabled):
+            assert label.palette().color(group, QPalette.ColorRole.WindowText).name() == COLOR_NEUTRAL

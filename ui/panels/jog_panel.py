@@ -37,6 +37,7 @@ from app.link.types import HaltKind, JogRequest, UnconfirmedHalt
 from app.protocol.enums import CARTESIAN_AXIS_NAMES, JOINT_AXIS_NAMES, TeachFrame
 from app.protocol.registers import NUM_AXES_TOTAL, NUM_ROBOT_AXES, TOOL_NONE
 from ui.touch import MOTION_MIN_HEIGHT, RowsScrollArea, mark_motion
+from ui.widgets_common import neutral_text
 
 DEFAULT_RATIO = 20
 # Keyboard jog: axis n (1..6) plus / minus. Letters on two rows of a QWERTY keyboard.
@@ -216,7 +217,7 @@ class JogPanel(QWidget):
             self.minus_buttons.append(minus)
             self.plus_buttons.append(plus)
         self.external_caption = QLabel(self.axes_rows)
-        self.external_caption.setStyleSheet("color: #5f6368;")
+        neutral_text(self.external_caption)
         self.external_caption.setAlignment(Qt.AlignmentFlag.AlignCenter)
         grid.addWidget(self.external_caption, 0, EXTERNAL_COLUMN, 1, 3)
         grid.setColumnMinimumWidth(EXTERNAL_COLUMN - 1, 8)
@@ -245,7 +246,7 @@ class JogPanel(QWidget):
         speed_row.addWidget(self.speed_value)
 
         self.keys_label = QLabel(self)  # one short line; the whole hint is its tooltip
-        self.keys_label.setStyleSheet("color: #5f6368;")
+        neutral_text(self.keys_label)
 
         layout = QVBoxLayout(self)
         layout.setContentsMargins(6, 6, 6, 4)

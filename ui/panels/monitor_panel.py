@@ -41,11 +41,10 @@ from app.models import Pose
 from app.safety.stopping import StopKind, StopMeasurement
 from ui.display_clock import DISPLAY_INTERVAL_MS, DisplayClock
 from ui.models.ring_buffer import RingBuffer
-from ui.palette import COLOR_NEUTRAL
 from ui.panels.monitor_figures import CARTESIAN as _CARTESIAN
 from ui.panels.monitor_figures import PLOT_INTERVAL_MS
 from ui.panels.monitor_readouts import BIG_POINTS_MAX, MIN_WIDTH, PANEL_MARGIN, ReadoutBoxes, readout_scale
-from ui.widgets_common import NumericReadout
+from ui.widgets_common import NumericReadout, neutral_text
 
 __all__ = [
     "PAINT_INTERVAL_MS",
@@ -151,7 +150,7 @@ class MonitorPanel(QWidget):
         self._plots_slot = plots
 
         self._status = QLabel(self)
-        self._status.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+        neutral_text(self._status)
         self._last_stop: StopMeasurement | None = None
         self._stops_measured = 0
 

@@ -53,7 +53,7 @@ from ui.palette import (
 )
 from ui.text_fit import both_languages, fit_in_every_language, fit_width
 from ui.widgets.number_text import fit_number, number_room, number_text
-from ui.widgets_common import monospace_font
+from ui.widgets_common import monospace_font, neutral_text
 
 __all__ = ["AGE_TICK_MS", "PoseStrip"]
 
@@ -129,7 +129,7 @@ class PoseStrip(QFrame):
         for name in CARTESIAN_AXIS_NAMES:
             caption = QLabel(name, self)
             caption.setFont(bold)
-            caption.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+            neutral_text(caption)
             value = QLabel("—", self)
             value.setObjectName(f"PoseStripValue{name}")
             value.setFont(monospace_font(VALUE_POINTS, bold=True))
@@ -141,7 +141,7 @@ class PoseStrip(QFrame):
             value.setFixedSize(room + VALUE_PADDING, value.sizeHint().height())
             value.setAutoFillBackground(True)
             unit = QLabel(self)
-            unit.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+            neutral_text(unit)
             self.captions[name], self.values[name], self.units[name] = caption, value, unit
             layout.addWidget(caption)
             layout.addWidget(value)
@@ -158,7 +158,7 @@ class PoseStrip(QFrame):
             chip.setFont(bold)
             chip.setAlignment(Qt.AlignmentFlag.AlignCenter)
         for caption_label in (self.mode_caption, self.program_caption):
-            caption_label.setStyleSheet(f"color: {COLOR_NEUTRAL};")
+            neutral_text(caption_label)
         fit_in_every_language(self._fix_widths)
         for widget in (
             self.mode_caption,
