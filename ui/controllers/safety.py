@@ -150,7 +150,7 @@ class SafetyController(QObject):
                 self._problem = str(exc)
         self.session = SafetySession(roles, audit, self.profile.envelope, on_role_changed=self._role_changed)
         # A fresh install's envelope is in force from here; its file and its audit record wait for
-        # the window's first paint (install_safety; ~10 ms: a file synced, the audit's hashing) or
+        # the window's first paint (install_safety; ~8 ms: a file synced, the audit's hashing) or
         # FRESH_SAVE_LATEST_MS, whichever comes first, and for nothing else that saves an envelope.
         self._fresh_unsaved = fresh
         if fresh:
