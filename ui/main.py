@@ -26,7 +26,7 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from PySide6.QtCore import QEvent, QObject, QTimer, Signal
+from PySide6.QtCore import QObject, QTimer, Signal
 from PySide6.QtWidgets import QApplication, QWidget
 
 from ui.first_paint import AfterFirstPaint
@@ -184,20 +184,12 @@ class _SimStarter(QObject):
         self._thread: threading.Thread | None = None
         self._closed = False
         self._lock = threading.Lock()
-        self._window = window
-        window.installEventFilter(self)
+        AfterFirstPaint(window, self.start)  # after the paint, on the next turn of the loop
         # a window that is not painted (minimized, on another desktop) still gets its simulator
         QTimer.singleShot(SIM_START_LATEST_MS, self, self.start)
 
-    def eventFilter(self, watched: QObject, event: QEvent) -> bool:
-        if watched is self._window and event.type() == QEvent.Type.Paint and self._thread is None:
-            self._window.removeEventFilter(self)
-            QTimer.singleShot(0, self.start)  # after this paint, on the next turn of the loop
-        return False
-
     def start(self) -> None:
         if self._thread is None and not self._closed:
-            self._window.removeEventFilter(self)  # (started without a paint: not needed any more)
             self._thread = threading.Thread(target=self._run, name="sim-start", daemon=True)
             self._thread.start()
 
