@@ -75,6 +75,7 @@ class SimController:
         self.writes: list[WriteRecord] = []
         self.writes_dropped = 0
         self._requests = 0
+        self._requests_on: dict[int | None, int] = {}  # requests by connection id
         self._port: int | None = None
         self._runner = ServerRunner()
         self._tick_thread: threading.Thread | None = None
@@ -274,6 +275,7 @@ class SimController:
         with self.lock:
             self._requests += 1
             serial = self._requests
+            self._requests_on[connection] = self._requests_on.get(connection, 0) + 1
             self._registers = registers
         if self._silent:
             return ExcCodes.DEVICE_FAILURE  # not executed; the answer is dropped by _trace_packet
@@ -418,6 +420,11 @@ class SimController:
     def requests_count(self) -> int:
         with self.lock:
             return self._requests
+
+    def requests_by_connection(self) -> dict[int | None, int]:
+        """Requests so far by connection id (those of :meth:`connection_ids`): which link carries what."""
+        with self.lock:
+            return dict(self._requests_on)
 
     @property
     def connections_count(self) -> int:

@@ -35,14 +35,27 @@ pytestmark = pytest.mark.timeout(60)
 POINT_TIMEOUT = 10.0  # s: a point in flight ends by its own timeouts only after this
 
 
+def _main_connection(qtbot: Any, sim: Any) -> int:
+    """The main link's connection: the one its polls arrive on (the stop line, with no keepalive,
+    is idle), not the older of the two -- a main link that reconnected under load is the younger."""
+    deadline = time.monotonic() + SIGNAL_TIMEOUT_MS / 1000
+    while time.monotonic() < deadline:
+        before, count = sim.requests_by_connection(), sim.requests_count
+        qtbot.waitUntil(lambda c=count: sim.requests_count >= c + 3, timeout=SIGNAL_TIMEOUT_MS)
+        after, open_ids = sim.requests_by_connection(), sim.connection_ids()
+        grew = [c for c in after if after[c] > before.get(c, 0)]
+        if len(open_ids) == 2 and len(grew) == 1 and grew[0] in open_ids:
+            return int(grew[0])
+    raise AssertionError("no one connection of the two carried the polls")
+
+
 def _line_open(qtbot: Any, link: RobotLink, sim: Any, monkeypatch: pytest.MonkeyPatch) -> int:
     """Connect, wait for the stop line, and refuse 441 on the main link's connection; its id."""
     monkeypatch.setattr(stop_line_module, "KEEPALIVE", 60.0)  # no keepalive read in the way of the stop
     connect(qtbot, link, sim)
     line = link._worker.stop_line  # the test waits for the line the product opens
     qtbot.waitUntil(lambda: line.opened_at > 0, timeout=SIGNAL_TIMEOUT_MS)
-    ids: list[int] = sim.connection_ids()
-    main, _stop_connection = ids  # the main link first, the stop line after it
+    main = _main_connection(qtbot, sim)
     stop_register = range(registers.REG_STOP, registers.REG_STOP + 1)
     sim.set_exception(ExcCodes.DEVICE_BUSY, stop_register, connection=main)
     return main

@@ -292,3 +292,21 @@ def test_another_master_polling_does_not_keep_a_silent_hosts_jog(
         event.t - silent_since < 0.2 + 0.5 and "connection" in event.detail and "no request" in event.detail
     )
     assert jogger.mode() == 2  # its connection is fine: only silent
+
+
+def test_requests_are_counted_by_the_connection_that_carried_them(sim: SimController) -> None:
+    """Two masters: the simulator tells which connection carried how many requests (a test finds a
+    link by what it carries, not by the order its connection opened in)."""
+    first = RawLink(sim.port)
+    first.ask(GOOD_READ)
+    second = RawLink(sim.port)
+    try:
+        for _ in range(3):
+            second.ask(GOOD_READ, tid=2)
+        counts = sim.requests_by_connection()
+        older, younger = sim.connection_ids()
+        assert counts == {older: 1, younger: 3}
+        assert sum(counts.values()) == sim.requests_count
+    finally:
+        first.close()
+        second.close()
