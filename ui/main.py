@@ -15,6 +15,11 @@ from ui.pyside_scan import skip_source_scan
 
 skip_source_scan()
 
+# Second: the methods dataclasses generate are compiled once, not at every start (ui/dataclass_code.py)
+from ui.dataclass_code import DATACLASS_CODE
+
+DATACLASS_CODE.install()
+
 import argparse
 import dataclasses
 import os
@@ -411,6 +416,7 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
     def after_first_paint() -> None:
         collector.start()
         measure_other_languages()  # the widths that fit every language (ui/text_fit.py)
+        DATACLASS_CODE.save()  # what this start compiled, for the next (once: a cached start writes nothing)
         # The link's worker (pymodbus, the envelope) is made by the connection, after the paint.
         if connection is not None:
             link.connect_to(connection)
@@ -527,6 +533,7 @@ def _close_down(
         starter.close()
     if not wait_for_detached_threads(THREADS_EXIT_WAIT):
         print("teachpad: the link to the controller did not close in time", file=sys.stderr)
+    DATACLASS_CODE.save()  # what the run compiled after its first paint (the worker's), if anything
     translator.uninstall()
     collector.stop()  # automatic collection is back when main() ends
     window.deleteLater()
