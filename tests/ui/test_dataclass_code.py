@@ -4,10 +4,8 @@ from __future__ import annotations
 
 import dataclasses
 import importlib.util
-import json
 import marshal
 import os
-import subprocess
 import sys
 import textwrap
 import types
@@ -17,9 +15,8 @@ from typing import Any
 
 import pytest
 
+from tests.ui.gui_child import ROOT, run_gui_child
 from ui.dataclass_code import DataclassCode, default_cache_path
-
-ROOT = Path(__file__).resolve().parents[2]
 
 # a module's text with the shapes TeachPad uses: frozen, defaults, a factory, ordering, slots,
 # and this file's own `from __future__ import annotations`
@@ -177,25 +174,10 @@ def test_a_second_start_of_the_window_compiles_no_dataclass_method_before_its_fi
         teachpad.MainWindow = Probe
         sys.exit(teachpad.main(["--settings", sys.argv[1], "--host", "127.0.0.1", "--port", "9"]))
     """)
-    env = {
-        **{k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"},
-        "QT_QPA_PLATFORM": "offscreen",
-        **{f"XDG_{d}_HOME": str(tmp_path / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
-    }
-    cache = tmp_path / "dc.marshal"
-    compiled = []
-    for _start in range(2):
-        out = subprocess.run(
-            [sys.executable, "-c", code, str(tmp_path / "teachpad.ini"), str(cache)],
-            cwd=ROOT,
-            capture_output=True,
-            text=True,
-            timeout=120,
-            env=env,
-            check=False,
-        )
-        line = next((x for x in out.stdout.splitlines() if x.startswith("FIRST_PAINT ")), None)
-        assert out.returncode == 0 and line is not None, out.stderr[-2000:]
-        compiled.append(json.loads(line[len("FIRST_PAINT ") :]))
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    cache = str(tmp_path / "dc.marshal")
+    compiled = [
+        run_gui_child(code, tmp_path, cache, env=env, expect="FIRST_PAINT")["FIRST_PAINT"] for _ in range(2)
+    ]
     assert compiled[0] > 300  # the window's ~85 dataclasses, ~5 methods each
     assert compiled[1] == 0

@@ -5,9 +5,6 @@ object in one is then destroyed on RobotWorker -- the signature of the segfault 
 from __future__ import annotations
 
 import gc
-import json
-import subprocess
-import sys
 import textwrap
 import threading
 import time
@@ -18,10 +15,9 @@ import pytest
 from PySide6.QtCore import QObject, Qt, QThread, QTimer, Slot
 
 from tests.cli.ctrl_c import untraced_env
+from tests.ui.gui_child import run_gui_child
 from ui.gui_gc import GuiThreadCollector, due_generation
 from ui.startup_gc import StartupGcPause
-
-ROOT = Path(__file__).resolve().parents[2]
 
 # these tests switch collection off and on themselves, and count passes in other threads
 pytestmark = pytest.mark.automatic_gc
@@ -68,22 +64,8 @@ _PROBE = textwrap.dedent("""
 
 
 def test_the_gui_process_collects_garbage_on_the_gui_thread_only(tmp_path: Path) -> None:
-    env = {
-        **untraced_env(),  # coverage's tracer in the child would allocate in every thread
-        "QT_QPA_PLATFORM": "offscreen",
-        **{f"XDG_{d}_HOME": str(tmp_path / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
-    }
-    out = subprocess.run(
-        [sys.executable, "-c", _PROBE, str(tmp_path / "teachpad.ini")],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env=env,
-        check=False,
-    )
-    lines = {x.split(" ", 1)[0]: json.loads(x.split(" ", 1)[1]) for x in out.stdout.splitlines() if " " in x}
-    assert out.returncode == 0 and "PASSES" in lines, out.stderr[-2000:]
+    # coverage's tracer in the child would allocate in every thread
+    lines = run_gui_child(_PROBE, tmp_path, env=untraced_env(), expect="PASSES")
     assert lines["DURING"] is False  # no automatic collection while the window lives
     assert lines["PASSES"]["other"] == 0, lines["PASSES"]  # none on the worker (nor any thread)
     assert lines["PASSES"]["gui"] > 0, lines["PASSES"]  # the GUI thread did collect

@@ -2,18 +2,13 @@
 
 from __future__ import annotations
 
-import json
-import os
-import subprocess
-import sys
 import textwrap
 from pathlib import Path
-from typing import Any
 
-ROOT = Path(__file__).resolve().parents[2]
+from tests.ui.gui_child import run_gui_child
 
 
-def test_nothing_heavy_is_imported_before_the_first_paint(tmp_path: Any) -> None:
+def test_nothing_heavy_is_imported_before_the_first_paint(tmp_path: Path) -> None:
     """``teachpad`` (ui.main.main) up to the window's first paint imports neither pymodbus nor
     numpy nor pyqtgraph (nor the plan runner or the project lock), makes no link worker and builds
     neither Points nor Planner, nor the Step and Program motion tabs: the start-up figure of
@@ -40,23 +35,7 @@ def test_nothing_heavy_is_imported_before_the_first_paint(tmp_path: Any) -> None
         teachpad.MainWindow = Probe
         sys.exit(teachpad.main(["--settings", sys.argv[1], "--host", "127.0.0.1", "--port", "9"]))
     """)
-    env = {
-        **os.environ,
-        "QT_QPA_PLATFORM": "offscreen",
-        **{f"XDG_{d}_HOME": str(tmp_path / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
-    }
-    out = subprocess.run(
-        [sys.executable, "-c", code, str(tmp_path / "teachpad.ini")],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env=env,
-        check=False,
-    )
-    line = next((x for x in out.stdout.splitlines() if x.startswith("FIRST_PAINT ")), None)
-    assert out.returncode == 0 and line is not None, out.stderr[-2000:]
-    seen, built = json.loads(line[len("FIRST_PAINT ") :])
+    seen, built = run_gui_child(code, tmp_path, expect="FIRST_PAINT")["FIRST_PAINT"]
     assert seen == []  # none of HEAVY
     # Points, Planner, the link's worker (--host connects after), Step, Program
     assert built == [False, False, False, False, False]

@@ -6,10 +6,8 @@ from __future__ import annotations
 
 import gc
 import json
-import subprocess
 import sys
 import textwrap
-from pathlib import Path
 from typing import Any
 
 import pytest
@@ -20,10 +18,9 @@ from app.safety.location import ENVELOPE_NAME
 from app.safety.profile import SafetyProfile, save_profile
 from app.view3d.profile import default_profile
 from tests.cli.ctrl_c import untraced_env
+from tests.ui.gui_child import run_gui_child
 from ui.panels.view3d_robot import RobotModelSource
 from ui.startup_gc import StartupGcPause, gc_paused
-
-ROOT = Path(__file__).resolve().parents[2]
 
 # Imported by their first use, after the window's first paint (not by the window's modules)
 DEFERRED = (
@@ -107,24 +104,11 @@ def test_deferred_modules_wait_and_the_collector_is_paused_until_the_first_paint
         print("AFTER_MAIN " + json.dumps(gc.isenabled()), flush=True)
         sys.exit(code)
     """)
-    env = {
-        # untraced: coverage's tracer, started in every child by `make test`, imports socket and
-        # hashlib itself (this test failed under coverage: ['hashlib', 'socket'] before the paint)
-        **untraced_env(),
-        "QT_QPA_PLATFORM": "offscreen",
-        **{f"XDG_{d}_HOME": str(tmp_path / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
-    }
-    out = subprocess.run(
-        [sys.executable, "-c", code, str(tmp_path / "teachpad.ini"), json.dumps([deferred, DEFERRED_QT])],
-        cwd=ROOT,
-        capture_output=True,
-        text=True,
-        timeout=120,
-        env=env,
-        check=False,
+    # untraced: coverage's tracer, started in every child by `make test`, imports socket and
+    # hashlib itself (this test failed under coverage: ['hashlib', 'socket'] before the paint)
+    lines = run_gui_child(
+        code, tmp_path, json.dumps([deferred, DEFERRED_QT]), env=untraced_env(), expect="STARTUP"
     )
-    lines = {x.split(" ", 1)[0]: json.loads(x.split(" ", 1)[1]) for x in out.stdout.splitlines() if " " in x}
-    assert out.returncode == 0 and "STARTUP" in lines, out.stderr[-2000:]
     seen, after_import, gc_at_paint, gc_after_paint, frozen_after_paint = lines["STARTUP"]
     assert seen == []  # none of DEFERRED (nor of DEFERRED_QT) before the first paint
     assert after_import is True  # importing ui.main leaves the collector as it found it
