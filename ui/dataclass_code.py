@@ -13,7 +13,8 @@ The key is the whole generated text, so a changed class is a new text: a stale e
 stand for new code (entries not used by a start are dropped at the next write). The file starts
 with the interpreter's bytecode magic number; a file from another interpreter, or one that does
 not read, is ignored and the texts are compiled as before. Compiled the way ``exec`` of a text in
-``dataclasses`` compiles it (file ``"<string>"``, no ``__future__`` flags inherited).
+``dataclasses`` compiles it (file ``"<string>"``, no ``__future__`` flags inherited). The file is
+code, trusted as the ``.pyc`` files in the same folder are (whoever can write one can write both).
 
 The hook is the name ``exec`` in the ``dataclasses`` module's globals, which its ``_create_fn``
 (3.11, 3.12) and ``_FuncBuilder`` (3.13) look up before the builtin: :meth:`DataclassCode.install`
