@@ -33,6 +33,16 @@ from typing import Final
 APP_DIR: Final = "teachpad"
 
 
+#: The XDG variables whose folders a TeachPad process writes to (CACHE: Qt's and the font cache)
+XDG_KINDS: Final = ("CONFIG", "DATA", "STATE", "CACHE")
+
+
+def fresh_user_dirs_env(root: str | os.PathLike[str]) -> dict[str, str]:
+    """``XDG_*_HOME`` for every folder of :data:`XDG_KINDS` under ``root`` (``root/config``, ...): a
+    process started with them is a fresh install of its own (tests, benchmarks; Linux)."""
+    return {f"XDG_{kind}_HOME": str(Path(root) / kind.lower()) for kind in XDG_KINDS}
+
+
 def _xdg(variable: str, *fallback: str) -> Path:
     value = os.environ.get(variable, "")
     if value and os.path.isabs(value):

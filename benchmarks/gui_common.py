@@ -14,6 +14,8 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import Any, Protocol
 
+from app.user_dirs import fresh_user_dirs_env
+
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 from PySide6.QtCore import QEvent, QEventLoop, QObject, Qt, QTimer
@@ -53,8 +55,7 @@ def private_user_dirs() -> None:
     if _user_dirs is not None:
         return
     _user_dirs = tempfile.TemporaryDirectory(prefix="teachpad-bench-user-")
-    for kind in ("CONFIG", "DATA", "STATE", "CACHE"):
-        os.environ[f"XDG_{kind}_HOME"] = str(Path(_user_dirs.name) / kind.lower())
+    os.environ.update(fresh_user_dirs_env(_user_dirs.name))
 
 
 def _qapp() -> QApplication:

@@ -11,6 +11,8 @@ import tempfile
 from pathlib import Path
 from typing import Any
 
+from app.user_dirs import fresh_user_dirs_env
+
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 
@@ -186,7 +188,7 @@ def bench_memory(
             os.environ,
             QT_QPA_PLATFORM="offscreen",
             PYTHONPATH=str(REPO),
-            **{f"XDG_{d}_HOME": str(user / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
+            **fresh_user_dirs_env(user),
         )
         env["TEACHPAD_BENCH_TRACE_AT"] = str(trace_at) if trace_at > 0 else ""
         args = [

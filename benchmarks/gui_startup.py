@@ -13,6 +13,8 @@ import time
 from pathlib import Path
 from typing import Any
 
+from app.user_dirs import fresh_user_dirs_env
+
 os.environ.setdefault("QT_QPA_PLATFORM", "offscreen")
 
 
@@ -139,7 +141,7 @@ def _startup_once(kind: str, home: Path, run: int) -> dict[str, float]:
         os.environ,
         QT_QPA_PLATFORM="offscreen",
         PYTHONPATH=str(REPO),
-        **{f"XDG_{d}_HOME": str(user / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
+        **fresh_user_dirs_env(user),
     )
     args = [kind, str(user / "teachpad.ini"), "{}x{}".format(*DEFAULT_SIZE)]
     t_spawn = time.monotonic()

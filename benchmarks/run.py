@@ -33,6 +33,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from app.user_dirs import fresh_user_dirs_env
 from benchmarks.goals import goals, guarded, table
 
 
@@ -120,9 +121,7 @@ def _warm_dataclass_code(root: Path) -> str:
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     env["QT_QPA_PLATFORM"] = "offscreen"
     with tempfile.TemporaryDirectory(prefix="teachpad-warm-") as tmp:
-        env.update(
-            {f"XDG_{d}_HOME": str(Path(tmp) / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")}
-        )
+        env.update(fresh_user_dirs_env(tmp))
         shot = Path(tmp) / "shot.png"
         try:
             done = subprocess.run(

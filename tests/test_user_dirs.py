@@ -63,3 +63,21 @@ def test_windows_folders_come_from_the_profile_variables(
     monkeypatch.setenv("HOME", str(tmp_path / "home"))
     monkeypatch.setenv("USERPROFILE", str(tmp_path / "home"))
     assert user_dirs.state_base().parts[-2:] == ("AppData", "Local")
+
+
+def test_a_fresh_user_dirs_env_puts_every_folder_teachpad_reads_under_one_root(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    env = user_dirs.fresh_user_dirs_env(tmp_path)
+    assert env == {
+        "XDG_CONFIG_HOME": str(tmp_path / "config"),
+        "XDG_DATA_HOME": str(tmp_path / "data"),
+        "XDG_STATE_HOME": str(tmp_path / "state"),
+        "XDG_CACHE_HOME": str(tmp_path / "cache"),
+    }
+    monkeypatch.setattr(sys, "platform", "linux")
+    for name, value in env.items():
+        monkeypatch.setenv(name, value)
+    assert user_dirs.config_base() == tmp_path / "config"
+    assert user_dirs.data_base() == tmp_path / "data"
+    assert user_dirs.state_base() == tmp_path / "state"

@@ -37,6 +37,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import IO
 
+from app.user_dirs import fresh_user_dirs_env
+
 __all__ = ["SessionResult", "main", "run_session"]
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -93,7 +95,7 @@ def run_session(
         QT_QPA_PLATFORM="offscreen",
         PYTHONPATH=os.pathsep.join(p for p in (str(ROOT), env.get("PYTHONPATH", "")) if p),
         PYTHONUNBUFFERED="1",
-        **{f"XDG_{d}_HOME": str(home / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
+        **fresh_user_dirs_env(home),
     )
     command = [sys.executable, "-X", "faulthandler", "-m", "tests.soak.gui"]
     command += ["--seed", str(seed), "--seconds", f"{seconds:g}", "--home", str(home / "home")]

@@ -11,6 +11,8 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from app.user_dirs import fresh_user_dirs_env
+
 ROOT = Path(__file__).resolve().parents[2]
 
 
@@ -24,7 +26,7 @@ def run_gui_child(
     child_env = {
         **(os.environ if env is None else env),
         "QT_QPA_PLATFORM": "offscreen",
-        **{f"XDG_{d}_HOME": str(tmp_path / d.lower()) for d in ("CONFIG", "DATA", "STATE", "CACHE")},
+        **fresh_user_dirs_env(tmp_path),
     }
     out = subprocess.run(
         [sys.executable, "-c", code, str(tmp_path / "teachpad.ini"), *args],
