@@ -416,10 +416,12 @@ def _main(argv: Sequence[str] | None, startup_gc: StartupGcPause) -> int:
     def after_first_paint() -> None:
         collector.start()
         measure_other_languages()  # the widths that fit every language (ui/text_fit.py)
-        DATACLASS_CODE.save()  # what this start compiled, for the next (once: a cached start writes nothing)
         # The link's worker (pymodbus, the envelope) is made by the connection, after the paint.
         if connection is not None:
             link.connect_to(connection)
+        # what this start compiled, for the next: after the connection is asked for (a first start's
+        # write, synced, does not delay it), before a session's question can hold the loop
+        DATACLASS_CODE.save()
         # A screenshot run never stops on a question: it opens only what it was given.
         _start_session(window, args.project, shot_run=bool(args.screenshot))
 
