@@ -336,7 +336,9 @@ def run(quick: bool) -> dict[str, Any]:
         ),
     )
     # The simulator in its own process, as a real controller would be: no GIL shared with it.
-    stall_s, n_stop, stop_budget = (2.0, 20, 2.0) if quick else (4.0, 60, 3.0)
+    # 300 stops: the goal's p99 is then the 3rd worst, not the worst of 60 (one late wake-up of a
+    # noisy machine was the figure); ~15 s on a quiet machine, the budget bounds a saturated one.
+    stall_s, n_stop, stop_budget = (2.0, 20, 2.0) if quick else (4.0, 300, 25.0)
     out["sim_separate_process"] = guarded(
         "sim_separate_process",
         lambda: _with_sim(
@@ -347,7 +349,7 @@ def run(quick: bool) -> dict[str, Any]:
         ),
     )
     t1 = time.perf_counter()
-    out["startup"] = guarded("startup", lambda: bench_startup(1 if quick else 5))  # 5: a steadier median
+    out["startup"] = guarded("startup", lambda: bench_startup(1 if quick else 9))  # 9: a steadier median
     out["startup"]["suite_s"] = time.perf_counter() - t1
     from benchmarks import view3d  # the 3D view's frame times (10,000 markers, 1,000 segments)
 

@@ -34,13 +34,14 @@ from pymodbus.client import ModbusTcpClient
 from app.cli.points_upload import staged_upload
 from app.connection import ConnectionSettings
 from app.link.client import RobotClient
+from app.models import CommandResult
 from app.points.point import TempPoint
 from app.protocol import registers as R  # noqa: N812
 from app.protocol.codec import encode_floats
 from app.sim.config import SimConfig
 from app.sim.server import SimController
 
-__all__ = ["BareSample", "RestoreRound", "bare_sample", "bench_restore", "summarize"]
+__all__ = ["BareSample", "RestoreRound", "bare_sample", "bench_restore", "summarize", "upload_in_rounds"]
 
 ROUNDS = 20
 SAMPLE_S = 0.2  # s of the bare loop before the first round and after each round
@@ -186,6 +187,28 @@ def summarize(
     }
 
 
+def upload_in_rounds(
+    client: RobotClient,
+    bare: ModbusTcpClient,
+    items: Sequence[tuple[int, Sequence[float]]],
+    size: int,
+    sample_s: float,
+    latency: float,
+) -> tuple[list[RestoreRound], list[BareSample], list[CommandResult]]:
+    """``client.upload_points`` on ``items`` in rounds of ``size``, a bare sample before the first
+    round and after each (what :func:`summarize` takes): (rounds, samples, results)."""
+    samples = [bare_sample(bare, sample_s, latency)]
+    done: list[RestoreRound] = []
+    results: list[CommandResult] = []
+    for start in range(0, len(items), size):
+        chunk = list(items[start : start + size])
+        t0, cpu0 = time.perf_counter(), time.thread_time()
+        results += client.upload_points(chunk)
+        done.append(RestoreRound(len(chunk), time.perf_counter() - t0, time.thread_time() - cpu0))
+        samples.append(bare_sample(bare, sample_s, latency))
+    return done, samples, results
+
+
 def bench_restore(
     points: Sequence[TempPoint], cli_n: int, *, rounds: int = ROUNDS, sample_s: float = SAMPLE_S
 ) -> dict[str, Any]:
@@ -201,17 +224,11 @@ def bench_restore(
         client.connect()
         try:
             latency = sim.config.command_latency
-            samples = [bare_sample(bare, sample_s, latency)]
-            done: list[RestoreRound] = []
-            results = []
             size = -(-n // rounds)
             requests = client.stats.requests
-            for start in range(0, n, size):
-                chunk = [(p.id, p.xyzabc) for p in points[start : start + size]]
-                t0, cpu0 = time.perf_counter(), time.thread_time()
-                results += client.upload_points(chunk)
-                done.append(RestoreRound(len(chunk), time.perf_counter() - t0, time.thread_time() - cpu0))
-                samples.append(bare_sample(bare, sample_s, latency))
+            done, samples, results = upload_in_rounds(
+                client, bare, [(p.id, p.xyzabc) for p in points], size, sample_s, latency
+            )
             requests = client.stats.requests - requests
             failed = sum(1 for r in results if not r.ok) + n - len(results)
             held = len(sim.state().points)

@@ -16,6 +16,7 @@ import math
 import os
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, Final
 
 from app.errors import InvalidInput, ProfileError
@@ -261,9 +262,9 @@ def profile_to_dict(profile: RobotProfile) -> dict[str, Any]:
 
 def default_profile() -> RobotProfile:
     """The simulator's arm (shipped with the package)."""
-    from importlib import resources  # ~2 ms: imported by the first use (after the window's first paint)
-
-    text = resources.files("app.view3d").joinpath("profiles", DEFAULT_PROFILE_FILE).read_text("utf-8")
+    # Beside this module, as the package ships it (and the bundle: packaging/teachpad.spec): not
+    # through importlib.resources, whose import costs a fresh install's first start ~10 ms
+    text = (Path(__file__).with_name("profiles") / DEFAULT_PROFILE_FILE).read_text("utf-8")
     return parse_profile(text, DEFAULT_PROFILE_FILE)
 
 
