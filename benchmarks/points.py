@@ -101,11 +101,21 @@ def bench_load(path: Path, repeats: int) -> dict[str, Any]:
     product()  # warm the file cache and imports
     # Interleaved, one of each per round: both sides of a ratio see the same minutes of a machine
     # whose speed drifts (all loads first, then all json.loads, measured each in another phase).
+    # Each timed without automatic collection, after a full one, as the GUI process loads a project
+    # (ui/gui_gc.py: its collections run from a timer, between events): otherwise which side a
+    # full pass over the bench's own heap lands in decides the pair.
     load_ms: list[float] = []
     json_ms: list[float] = []
-    for _ in range(repeats):
-        load_ms.append(_median_ms(product, 1))
-        json_ms.append(_median_ms(baseline, 1))
+    was_enabled = gc.isenabled()
+    try:
+        for _ in range(repeats):
+            for fn, times in ((product, load_ms), (baseline, json_ms)):
+                gc.collect()
+                gc.disable()
+                times.append(_median_ms(fn, 1))
+    finally:
+        if was_enabled:
+            gc.enable()
     load, base = statistics.median(load_ms), statistics.median(json_ms)
     paired = statistics.median(a / b for a, b in zip(load_ms, json_ms, strict=True))
     return {
