@@ -17,6 +17,7 @@ from PySide6.QtCore import QCoreApplication, QEvent, QPointF, Qt, QTimer
 from PySide6.QtGui import QMouseEvent
 
 from app.link.ops import RunProgram
+from app.link.stop_line import StopLine, StopSent
 from app.protocol import registers as R  # noqa: N812
 from app.protocol.enums import ProgramMotionMode
 from app.sim.config import WriteRecord
@@ -39,6 +40,31 @@ from ui.main_window import MainWindow
 # --------------------------------------------------------------------------------------------
 # 1. Stop latency
 # --------------------------------------------------------------------------------------------
+
+
+class _SendClock:
+    """Where a stop's time goes: wraps :meth:`StopLine.send_stop` (the stop line's one system call,
+    made by the thread that pressed Stop) for the life of the ``with`` block and keeps the
+    monotonic time each stop it took was sent. A stop the line could not take (busy with a
+    keepalive read, an answer not yet read) went through the worker's queue: no time."""
+
+    def __init__(self) -> None:
+        self.sent: list[float | None] = []
+        self._original = StopLine.send_stop
+
+    def __enter__(self) -> _SendClock:
+        original, sent = self._original, self.sent
+
+        def send_stop(line: StopLine) -> StopSent | None:
+            on_line = original(line)
+            sent.append(on_line.sent_mono if on_line is not None else None)
+            return on_line
+
+        StopLine.send_stop = send_stop  # type: ignore[method-assign, assignment]
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        StopLine.send_stop = self._original  # type: ignore[method-assign]
 
 
 class _GuiStopper:
@@ -113,6 +139,14 @@ class _GuiStopper:
         """The last stop's: the simulator's write time minus the time just before the press."""
         return self.found[0].t - float(self.pending["t0"])
 
+    def split(self, sent: float | None) -> tuple[float, float] | None:
+        """The last stop's two parts around its send on the stop line (``sent``, monotonic): the
+        press to the send (this process: the click, the slot, the link), the send to the
+        simulator's write (the loopback, the simulator process waking up and answering)."""
+        if sent is None:
+            return None
+        return sent - float(self.pending["t0"]), self.found[0].t - sent
+
 
 def bench_stop_gui(
     window: MainWindow,
@@ -135,26 +169,32 @@ def bench_stop_gui(
     stopper = _GuiStopper(window, sim, counters, posted=posted)
     spread = INPUT_PHASE_SPREAD_S if posted else 1.0 / POLL_HZ
     latencies: list[float] = []
+    parts: list[tuple[float, float]] = []
     failures = 0
     deadline = time.monotonic() + budget_s
     out: dict[str, Any] = {"budget_exhausted": False}
-    for i in range(n + WARMUP_SAMPLES):
-        if time.monotonic() > deadline:
-            out["budget_exhausted"] = True
-            break
-        if not stopper.motion_running():
-            failures += 1
-            continue
-        # Just after a poll: a uniform delay over one poll period (posted input: over one paint
-        # period of the monitor, several polls) spreads the stop over the cycle.
-        if not stopper.press_stop(rng.uniform(0.0, spread)):
-            failures += 1
-            continue
-        # Let the worker finish the stop job ("stop: sent") before the next run request.
-        if not stopper.stop_sent():
-            failures += 1
-        if i >= WARMUP_SAMPLES:
-            latencies.append(stopper.latency())
+    with _SendClock() as clock:
+        for i in range(n + WARMUP_SAMPLES):
+            if time.monotonic() > deadline:
+                out["budget_exhausted"] = True
+                break
+            if not stopper.motion_running():
+                failures += 1
+                continue
+            # Just after a poll: a uniform delay over one poll period (posted input: over one paint
+            # period of the monitor, several polls) spreads the stop over the cycle.
+            del clock.sent[:]
+            if not stopper.press_stop(rng.uniform(0.0, spread)):
+                failures += 1
+                continue
+            # Let the worker finish the stop job ("stop: sent") before the next run request.
+            if not stopper.stop_sent():
+                failures += 1
+            if i >= WARMUP_SAMPLES:
+                latencies.append(stopper.latency())
+                split = stopper.split(clock.sent[0] if clock.sent else None)
+                if split is not None:
+                    parts.append(split)
     reason = (
         "the time budget ran out before a stop was measured"
         if out["budget_exhausted"]
@@ -162,6 +202,10 @@ def bench_stop_gui(
     )
     out.update(_summary_ms(latencies, reason))
     out["failures"] = failures
+    # The same stops in two parts (those the stop line carried): what this process spent before
+    # the send, and what the loopback and the simulator's process took after it.
+    out["press_to_send"] = _summary_ms([p for p, _ in parts], "no stop went on the stop line")
+    out["send_to_write"] = _summary_ms([w for _, w in parts], "no stop went on the stop line")
     return out
 
 

@@ -1,5 +1,6 @@
-"""The core suite's upload figure is judged as restore-all's is: rounds, each against the bare loop
-sampled beside it; and the project load's ratio pairs each load with a json.load right after it."""
+"""How make bench judges the goals near their bounds: the upload as restore-all (rounds, each against
+the bare loop sampled beside it), the project load beside a json.load round by round, and each GUI
+stop split at its send on the stop line (this process's part, the simulator's part)."""
 
 from __future__ import annotations
 
@@ -60,3 +61,17 @@ def test_the_project_load_is_timed_beside_a_json_load_round_by_round(
     # one warm-up load, then a load and a json.load in each round, interleaved
     assert calls == ["product"] + ["product", "json"] * 3
     assert out["repeats"] == 3 and out["ratio_load_vs_json"] > 0 and out["ratio_of_medians"] > 0
+
+
+def test_the_stop_bench_times_each_send_on_the_stop_line_and_puts_the_line_back() -> None:
+    from app.link.stop_line import StopLine
+    from benchmarks.gui_stop import _SendClock
+
+    original = StopLine.send_stop
+    line = StopLine()  # not connected: it cannot take a stop (the worker's queue carries it)
+    with _SendClock() as clock:
+        assert StopLine.send_stop is not original
+        assert line.send_stop() is None
+        assert line.stops_requested == 1  # the product's own method ran
+    assert clock.sent == [None]  # a stop the line did not carry has no send time
+    assert StopLine.send_stop is original
