@@ -144,9 +144,10 @@ def _measure_streaming_busy(
         out = measure_stalls(seconds)
         elapsed = time.perf_counter() - t0
         out["polls_per_s"] = (sim.requests() - requests0) / 2 / elapsed
+        # the rates of the probe's window (they were counted through the no-probe window too)
+        out["poses_per_s"] = (counters.poses - poses0) / elapsed
+        out["traffic_frames_per_s"] = (counters.traffic_frames - frames0) / elapsed
         add_no_probe(out, seconds)
-    out["poses_per_s"] = (counters.poses - poses0) / elapsed
-    out["traffic_frames_per_s"] = (counters.traffic_frames - frames0) / elapsed
     _per_100hz(out)
     out["busy_neighbour_procs"] = busy.procs
     out["monitor_shown"] = not window.monitor_panel.visibleRegion().isEmpty()
