@@ -53,6 +53,7 @@ from app.points.project import load_project, save_project
 from app.points.project_model import Project
 from benchmarks import completion, restore
 from benchmarks.restore import QUICK_SAMPLE_S, ROUNDS, SAMPLE_S
+from ui.startup_gc import gc_paused
 
 PROJECT_POINTS = 10_000
 PLAN_SEGMENTS = 1_000
@@ -106,16 +107,11 @@ def bench_load(path: Path, repeats: int) -> dict[str, Any]:
     # full pass over the bench's own heap lands in decides the pair.
     load_ms: list[float] = []
     json_ms: list[float] = []
-    was_enabled = gc.isenabled()
-    try:
-        for _ in range(repeats):
-            for fn, times in ((product, load_ms), (baseline, json_ms)):
-                gc.collect()
-                gc.disable()
+    for _ in range(repeats):
+        for fn, times in ((product, load_ms), (baseline, json_ms)):
+            gc.collect()
+            with gc_paused():
                 times.append(_median_ms(fn, 1))
-    finally:
-        if was_enabled:
-            gc.enable()
     load, base = statistics.median(load_ms), statistics.median(json_ms)
     paired = statistics.median(a / b for a, b in zip(load_ms, json_ms, strict=True))
     return {
@@ -282,13 +278,8 @@ def bench_autosave(quick: bool) -> dict[str, Any]:
 
     _qt_app()
     project = _large_project(10 if quick else 1)
-    was_enabled = gc.isenabled()
-    gc.disable()  # as in the GUI process (ui/gui_gc.py): no collection in the writer's thread
-    try:
+    with gc_paused():  # as in the GUI process (ui/gui_gc.py): no collection in the writer's thread
         return _autosave_figures(project, ProjectController, save_autosave)
-    finally:
-        if was_enabled:
-            gc.enable()
 
 
 def _autosave_figures(project: Project, controller: Any, save_autosave: Callable[..., Any]) -> dict[str, Any]:
