@@ -70,6 +70,13 @@ FONT_SETS: tuple[FontSet, ...] = (
         ("fonts-noto-core", "fonts-noto-mono", "fonts-noto-cjk"),
         "Noto Sans, Noto Sans Mono, Noto Sans CJK",
     ),
+    FontSet(
+        "dejavu-cjk",
+        ("usr/share/fonts/truetype/dejavu", "usr/share/fonts/opentype/noto"),
+        ("fonts-dejavu-core", "fonts-noto-cjk"),
+        "DejaVu Sans / Sans Mono with Noto Sans CJK for Chinese (a Debian desktop with fonts-noto-cjk): "
+        "the Chinese lines are taller than the Latin font's (18 px against 14 at 9 pt)",
+    ),
 )
 
 

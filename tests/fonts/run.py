@@ -5,8 +5,10 @@ file that lists only them, then pytest in a process of its own with ``FONTCONFIG
 ``QT_SCALE_FACTOR`` and ``TEACHPAD_LAYOUT_SCREENS`` set: at 100 % the layout check
 (``test_layout.py``), the live views' relayout checks (``test_live_views_cost.py``) and the
 whole-number readouts (``test_readouts_whole.py``) at the README's minimum screen, 1280×800 and
-1920×1080, both languages; at 125 % and 150 % the main window's layout check on those screens
-(each as large as the scale leaves it; see ``test_layout.window_sizes``) and the relayout check.
+1920×1080, both languages, the "another master" banner's two lines (``test_foreign_banner_layout.py``)
+and the few-line labels (``tests/ui/widgets/test_lines_label.py``); at 125 % and 150 % the main
+window's layout check on those screens (each as large as the scale leaves it; see
+``test_layout.window_sizes``) and the relayout check.
 Two processes at a time (the machine has two cores). A missing set is named with the packages
 that bring it and fails the run only with ``--require-all`` (CI installs them first).
 """
@@ -32,6 +34,8 @@ FULL = [
     "tests/ui/test_layout.py",
     "tests/ui/panels/test_live_views_cost.py",
     "tests/ui/test_readouts_whole.py",
+    "tests/ui/test_foreign_banner_layout.py",
+    "tests/ui/widgets/test_lines_label.py",
 ]
 SCALED = [
     "tests/ui/test_layout.py::test_main_window_layout",

@@ -8,9 +8,9 @@ from __future__ import annotations
 
 import os
 from collections.abc import Callable
+from typing import Any
 
 import pytest
-from PySide6.QtGui import QFontMetrics
 from PySide6.QtWidgets import QLabel
 
 from tests.ui.pendant_support import (  # noqa: F401 - fixtures
@@ -31,15 +31,41 @@ SIGNS = (("gv291", 17279.0), ("canary", 8388607.0), ("registers", 1199.0))  # th
 
 
 def wrapped_lines(label: QLabel) -> int:
-    """How many lines ``label``'s text wraps to at its width (a one-line probe of the same style
-    gives the padding and border)."""
-    probe = QLabel("X")
-    probe.setStyleSheet(label.styleSheet())
-    probe.setFont(label.font())
-    probe.setWordWrap(True)
-    one = probe.heightForWidth(label.width())
-    line = QFontMetrics(label.font()).lineSpacing()
+    """How many lines ``label``'s text wraps to at its width. The one-line height and the line
+    height come from probes of the same style holding the label's own text unwrapped (once, then
+    twice): a Chinese line is taller than the Latin font's line spacing when its glyphs come from a
+    fallback font (DejaVu Sans with Noto Sans CJK: 18 px against 14), and counting it in the
+    Latin font's lines saw three lines where two were shown."""
+
+    def unwrapped(text: str) -> int:
+        probe = QLabel(text)
+        probe.setStyleSheet(label.styleSheet())
+        probe.setFont(label.font())
+        probe.setWordWrap(True)
+        return probe.heightForWidth(100_000)
+
+    one = unwrapped(label.text())
+    line = unwrapped(label.text() + "\n" + label.text()) - one
     return 1 + round((label.heightForWidth(label.width()) - one) / line)
+
+
+@pytest.mark.parametrize(
+    ("line", "text"),
+    [
+        ("路径全部在工作范围", "路径全部在工作范围" * 3),
+        ("alpha", "alpha alpha alpha"),
+        ("中文 alpha", "中文 alpha 中文 alpha 中文 alpha"),
+    ],
+    ids=["zh", "en", "mixed"],
+)
+def test_wrapped_lines_counts_the_lines_shown(qtbot: Any, line: str, text: str) -> None:
+    label = QLabel(text)  # ``line`` three times, as wide as ``line`` and its margins: three lines shown
+    qtbot.addWidget(label)
+    label.setWordWrap(True)
+    label.setStyleSheet("padding: 4px; border: 1px solid")
+    width = label.fontMetrics().horizontalAdvance(line) + 30  # (less than two lines' width)
+    label.resize(width, label.heightForWidth(width))
+    assert wrapped_lines(label) == 3
 
 
 @pytest.mark.parametrize(("what", "value"), SIGNS, ids=[s[0] for s in SIGNS])

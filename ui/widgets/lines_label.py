@@ -4,10 +4,22 @@ whole of it in the tooltip (``elide=True`` for the layout check)."""
 from __future__ import annotations
 
 from PySide6.QtCore import QRect, Qt
-from PySide6.QtGui import QResizeEvent
+from PySide6.QtGui import QFontMetrics, QResizeEvent
 from PySide6.QtWidgets import QLabel, QWidget
 
-__all__ = ["LinesLabel"]
+__all__ = ["LinesLabel", "lines_height"]
+
+# A Latin and a Chinese glyph: a line of it is as tall as the taller of the UI's two scripts. The
+# Chinese glyphs come from a fallback font (Noto Sans CJK beside DejaVu Sans on a Debian desktop)
+# whose lines are taller than the Latin font's (18 px against 14 at 9 pt): a height made of the
+# widget font's line spacing cut every Chinese line, and a one-line label showed only "…".
+_PROBE_LINE = "Ag \u4e2d"
+
+
+def lines_height(metrics: QFontMetrics, lines: int) -> int:
+    """The height of ``lines`` wrapped lines of text in either of the UI's languages (px)."""
+    probe = "\n".join([_PROBE_LINE] * lines)
+    return metrics.boundingRect(QRect(0, 0, 10_000, 10_000), int(Qt.TextFlag.TextWordWrap), probe).height()
 
 
 class LinesLabel(QLabel):
@@ -21,7 +33,7 @@ class LinesLabel(QLabel):
         self.setProperty("elide", True)
         self.setWordWrap(True)
         self.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
-        self.setFixedHeight(lines * self.fontMetrics().lineSpacing() + 2)
+        self.setFixedHeight(lines_height(self.fontMetrics(), lines) + 2)
 
     def text(self) -> str:
         """The whole text, also when the label shows it cut short."""
