@@ -7,7 +7,7 @@ from PySide6.QtCore import QRect, Qt
 from PySide6.QtGui import QFontMetrics, QResizeEvent
 from PySide6.QtWidgets import QLabel, QWidget
 
-__all__ = ["LinesLabel", "lines_height"]
+__all__ = ["LinesLabel"]
 
 # A Latin and a Chinese glyph: a line of it is as tall as the taller of the UI's two scripts. The
 # Chinese glyphs come from a fallback font (Noto Sans CJK beside DejaVu Sans on a Debian desktop)
@@ -16,7 +16,7 @@ __all__ = ["LinesLabel", "lines_height"]
 _PROBE_LINE = "Ag \u4e2d"
 
 
-def lines_height(metrics: QFontMetrics, lines: int) -> int:
+def _lines_height(metrics: QFontMetrics, lines: int) -> int:
     """The height of ``lines`` wrapped lines of text in either of the UI's languages (px)."""
     probe = "\n".join([_PROBE_LINE] * lines)
     return metrics.boundingRect(QRect(0, 0, 10_000, 10_000), int(Qt.TextFlag.TextWordWrap), probe).height()
@@ -33,7 +33,7 @@ class LinesLabel(QLabel):
         self.setProperty("elide", True)
         self.setWordWrap(True)
         self.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
-        self.setFixedHeight(lines_height(self.fontMetrics(), lines) + 2)
+        self.setFixedHeight(_lines_height(self.fontMetrics(), lines) + 2)
 
     def text(self) -> str:
         """The whole text, also when the label shows it cut short."""
