@@ -138,7 +138,7 @@ def describe_fonts(env: dict[str, str] | None = None) -> str:
 
 def main(argv: list[str]) -> int:
     if argv == ["--packages"]:
-        print(" ".join(p for s in FONT_SETS for p in s.packages))
+        print(" ".join(dict.fromkeys(p for s in FONT_SETS for p in s.packages)))  # each once
         return 0
     if len(argv) != 2:
         print(__doc__, file=sys.stderr)
