@@ -12,7 +12,10 @@ __all__ = ["LinesLabel"]
 # A Latin and a Chinese glyph: a line of it is as tall as the taller of the UI's two scripts. The
 # Chinese glyphs come from a fallback font (Noto Sans CJK beside DejaVu Sans on a Debian desktop)
 # whose lines are taller than the Latin font's (18 px against 14 at 9 pt): a height made of the
-# widget font's line spacing cut every Chinese line, and a one-line label showed only "…".
+# widget font's line spacing cut every Chinese line, and a one-line label showed only "…". The
+# height is the probe's, with no slack: where the lines are as tall in both scripts (Noto Sans with
+# Noto Sans CJK) it is what the old ``lines x line spacing + 2`` was, and the touch layout at
+# 1280x800 has no pixel to spare there.
 _PROBE_LINE = "Ag \u4e2d"
 
 
@@ -33,7 +36,7 @@ class LinesLabel(QLabel):
         self.setProperty("elide", True)
         self.setWordWrap(True)
         self.setAlignment(Qt.AlignmentFlag.AlignLeft | Qt.AlignmentFlag.AlignTop)
-        self.setFixedHeight(_lines_height(self.fontMetrics(), lines) + 2)
+        self.setFixedHeight(_lines_height(self.fontMetrics(), lines))  # (no slack: 1 px decides a layout)
 
     def text(self) -> str:
         """The whole text, also when the label shows it cut short."""
